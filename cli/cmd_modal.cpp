@@ -1,0 +1,72 @@
+// dynid modal CASE [--modes N] [--json FILE]: modal analysis of a case's model.
+#include <fmt/core.h>
+
+#include "commands.hpp"
+#include "dynid/engine/modal.hpp"
+#include "dynid/io/case_file.hpp"
+#include "dynid/io/output.hpp"
+#include "progress.hpp"
+
+namespace dynid::cli {
+
+namespace {
+struct ModalArgs {
+  std::string case_path;
+  int modes = 0;
+  std::string json;
+  bool force = false;
+};
+
+int run_modal(const ModalArgs& a, const GlobalOptions& g) {
+  set_threads(g.threads);
+  Case c = load_case(a.case_path);
+  for (const std::string& w : c.model.warnings())
+    if (!g.quiet) fmt::print(stderr, "dynid modal: warning: {}: {}\n", c.path, w);
+  EigenOptions opt = c.analysis.eigen_options();
+  if (a.modes > 0) {
+    opt.num_modes = a.modes;
+    opt.band_lo = opt.band_hi = std::numeric_limits<double>::quiet_NaN();
+  }
+  Progress progress(!g.quiet);
+  opt.progress = [&](std::string_view stage, double f) { progress.update(stage, f); };
+  const ModalResult r = modal_analysis(c.model, opt);
+  progress.done();
+  if (!g.quiet) {
+    fmt::print("dynid modal: {} ({} DOFs, {} nonzeros)\n", c.name, r.dofs, r.nonzeros);
+    fmt::print("  mode  frequency [Hz]   kind\n");
+    int elastic = 0, rigid = 0;
+    for (Eigen::Index k = 0; k < r.eigenvalues.size(); ++k) {
+      std::string kind;
+      if (r.rigid_body[k]) {
+        kind = "rigid body";
+        if (rigid < static_cast<int>(r.rigid_body_descriptions.size()))
+          kind += " (" + r.rigid_body_descriptions[rigid] + ")";
+        ++rigid;
+      } else {
+        kind = fmt::format("elastic {}", ++elastic);
+      }
+      fmt::print("  {:4d}  {:14.6g}   {}\n", k + 1, r.frequencies_hz[k], kind);
+    }
+    if (g.verbose) fmt::print("{}", r.summary.FullReport());
+  }
+  if (!a.json.empty()) write_file_atomic(a.json, modal_json(c, r).dump(1) + "\n", a.force);
+  if (!r.ok()) {
+    fmt::print(stderr, "dynid modal: {}\n", r.summary.BriefReport());
+    return 1;
+  }
+  return 0;
+}
+}  // namespace
+
+void register_modal(CLI::App& app, GlobalOptions& g) {
+  auto a = std::make_shared<ModalArgs>();
+  CLI::App* cmd = app.add_subcommand("modal", "Modal analysis: the lowest modes (or a band) of a case's model");
+  cmd->add_option("CASE", a->case_path, "Case file or folder (with case.yaml)")->required();
+  cmd->add_option("--modes", a->modes, "Number of lowest modes, rigid-body modes included (overrides the case)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--json", a->json, "Write the results as JSON to FILE");
+  cmd->add_flag("--force", a->force, "Overwrite existing output files");
+  cmd->callback([a, &g]() { g.exit_code = run_guarded("modal", [&] { return run_modal(*a, g); }); });
+}
+
+}  // namespace dynid::cli

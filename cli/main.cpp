@@ -1,0 +1,50 @@
+// dynid -- command line. Exit codes: 0 success; 1 numerical failure (solver did not converge, singular
+// matrix); 2 bad input or usage (the message says what and where); 3 internal error (please report).
+#include <CLI/CLI.hpp>
+#include <dlfcn.h>
+#include <fmt/core.h>
+
+#include <cstdio>
+#include <iostream>
+
+#include "commands.hpp"
+#include "dynid/mesh/error.hpp"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace dynid::cli {
+
+void set_threads(int n) {
+  if (n <= 0) return;
+#ifdef _OPENMP
+  omp_set_num_threads(n);
+#endif
+  // OpenBLAS (used by CHOLMOD's supernodal factorization) has its own thread pool.
+  using SetThreads = void (*)(int);
+  if (auto f = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) f(n);
+}
+
+}  // namespace dynid::cli
+
+int main(int argc, char** argv) {
+  using namespace dynid::cli;
+  CLI::App app{"dynid: finds where a structure differs from its finite-element model, and why, from vibration "
+               "measurements.\nExit codes: 0 success, 1 numerical failure, 2 bad input or usage, 3 internal error."};
+  app.require_subcommand(1);
+  app.fallthrough();  // global options may follow the subcommand
+  GlobalOptions g;
+  app.add_option("--threads", g.threads, "Threads for assembly, factorization and residuals (default: all cores)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("-q,--quiet", g.quiet, "Print only errors");
+  app.add_flag("-v,--verbose", g.verbose, "Print solver details");
+  register_commands(app, g);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+  return g.exit_code;
+}

@@ -1,0 +1,175 @@
+// dynid/mesh/model.hpp -- the structural model: nodes, materials, sections, elements, supports.
+//
+// Units are the user's, consistently (the bundled cases use SI: m, kg, s, N). Element types:
+//   Beam2D   Euler-Bernoulli beam along the global x axis; DOFs (uy, rz) per node; bending stiffness E*Iz.
+//   Frame2D  plane frame in the x-y plane; DOFs (ux, uy, rz) per node (Chandrupatla & Belegundu).
+//   Frame3D  space frame; DOFs (ux, uy, uz, rx, ry, rz) per node; local axes from an orientation vector.
+//   PointMass  mass m on the node's active translations, rotary inertia (Jx, Jy, Jz) on its active rotations.
+//   Spring   translational or rotational spring on a set of DOF types, grounded (one node) or between two nodes.
+// Each element's global DOF map and its stiffness and mass matrices are available per element
+// (element_dofs(), element_matrices(), element_parts()); sensitivities and residual forces use them.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <map>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "dynid/mesh/dof.hpp"
+#include "dynid/mesh/element_source.hpp"
+
+namespace dynid {
+
+namespace internal {
+struct MemberLocal;
+}
+
+enum class ElementType { Beam2D, Frame2D, Frame3D, PointMass, Spring };
+std::string_view element_type_name(ElementType t);  // "beam2d", "frame2d", "frame3d", "point_mass", "spring"
+bool parse_element_type(std::string_view name, ElementType* out);
+
+enum class MassType { Consistent, Lumped };
+
+struct Node {
+  int id = 0;                               // user id (any integer, unique)
+  Eigen::Vector3d x = Eigen::Vector3d::Zero();  // coordinates
+};
+
+struct Material {
+  std::string name;
+  double E = 0;     // Young's modulus
+  double G = 0;     // shear modulus; 0 = E / (2 (1 + nu))
+  double nu = 0.3;  // Poisson's ratio, used when G = 0
+  double rho = 0;   // density
+  double shear_modulus() const { return G > 0 ? G : E / (2.0 * (1.0 + nu)); }
+};
+
+struct Section {
+  std::string name;
+  double A = 0;   // area
+  double Iy = 0;  // second moment about the local y axis (3D frames: bending in the local x-z plane)
+  double Iz = 0;  // second moment about the local z axis (bending in the plane of 2D beams and frames)
+  double J = 0;   // torsion constant (3D frames); 0 = Iy + Iz
+  double torsion_constant() const { return J > 0 ? J : Iy + Iz; }
+};
+
+/// Multiplicative factors on an element's properties (1 = nominal). Damage studies and model updating act
+/// through them: stiffness ~ E, mass ~ rho, both ~ A (axial stiffness and translational mass) and I (bending).
+struct PropertyFactors {
+  double E = 1, rho = 1, A = 1, I = 1;
+};
+
+struct Element {
+  int id = 0;
+  ElementType type = ElementType::Frame2D;
+  std::array<int, 2> node_ids{{0, 0}};  // user node ids; node_ids[1] unused for one-node elements
+  int num_nodes = 2;                    // 1 for point masses and grounded springs
+  int material = -1;                    // index into Model::materials() (beams and frames)
+  int section = -1;                     // index into Model::sections()  (beams and frames)
+  Eigen::Vector3d orientation = Eigen::Vector3d::Zero();  // Frame3D: a vector in the local x-z plane; 0 = default
+  double mass = 0;                                        // PointMass
+  Eigen::Vector3d rotary_inertia = Eigen::Vector3d::Zero();  // PointMass: about global x, y, z
+  DofMask spring_dofs = 0;                                   // Spring: DOF types it acts on
+  double stiffness = 0;                                      // Spring: per DOF (N/m or N m/rad)
+  PropertyFactors factors;
+  std::string group;  // optional group name (updating parameters may act per group)
+};
+
+/// Element matrices split into parts that are linear in one property each, in global coordinates:
+///   K = K_axial (~ E A) + K_bending (~ E I) + K_torsion (~ G J) + K_discrete (springs)
+///   M = M_translational (~ rho A) + M_rotary (~ rho I, only with rotary inertia) + M_discrete (point masses)
+/// Each part already includes the element's current property factors.
+struct ElementParts {
+  Eigen::MatrixXd K_axial, K_bending, K_torsion, K_discrete;
+  Eigen::MatrixXd M_translational, M_rotary, M_discrete;
+  Eigen::MatrixXd K() const;
+  Eigen::MatrixXd M() const;
+};
+
+/// The structural model. Build it with the add_* functions, then call finalize(), which validates everything,
+/// resolves node ids and numbers the DOFs. After finalize() the model is an ElementSource.
+class Model : public ElementSource {
+ public:
+  // ---- building --------------------------------------------------------------------------------------
+  int add_node(int id, const Eigen::Vector3d& x);  // returns the node index; throws InputError on duplicate id
+  int add_material(const Material& m);             // returns the material index
+  int add_section(const Section& s);               // returns the section index
+  int add_element(const Element& e);               // returns the element index (ids must be unique)
+  /// Restrains DOF types at a node (given by user id). Restraining an inactive DOF type is allowed (ignored).
+  void restrain(int node_id, DofMask dofs);
+  void set_mass_type(MassType t) { mass_type_ = t; }
+  void set_rotary_inertia(bool on) { rotary_inertia_ = on; }
+  /// Declares that the structure is meant to be unsupported (free-free): rigid-body modes are then expected.
+  /// Without this, finalize() rejects a model whose supports and springs leave rigid-body motions free.
+  void set_free_free(bool on) { free_free_ = on; }
+
+  /// Validates the model and numbers the DOFs. Throws InputError naming the entity and the problem.
+  void finalize();
+  bool finalized() const { return finalized_; }
+
+  // ---- access ----------------------------------------------------------------------------------------
+  const std::vector<Node>& nodes() const { return nodes_; }
+  const std::vector<Material>& materials() const { return materials_; }
+  const std::vector<Section>& sections() const { return sections_; }
+  const std::vector<Element>& elements() const { return elements_; }
+  Element& element(int e) { return elements_[e]; }  // e.g. to change property factors; DOFs stay valid
+  MassType mass_type() const { return mass_type_; }
+  bool rotary_inertia() const { return rotary_inertia_; }
+  bool free_free() const { return free_free_; }
+  const DofMap& dof_map() const { return dofs_; }
+  /// Node index of a user id, or -1.
+  int node_index(int id) const;
+  /// Element index of a user id, or -1.
+  int element_index(int id) const;
+  /// Node indices of element e (resolved at finalize()).
+  const std::array<int, 2>& element_nodes(int e) const { return element_nodes_[e]; }
+  int material_index(const std::string& name) const;  // -1 if absent
+  int section_index(const std::string& name) const;   // -1 if absent
+  /// Non-fatal remarks collected by finalize() (e.g. nodes not connected to any element).
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  /// Human-readable DOF description: "uy at node 14".
+  std::string describe_dof(int eq) const;
+
+  // ---- ElementSource ----------------------------------------------------------------------------------
+  int num_dofs() const override { return dofs_.num_free(); }
+  int num_elements() const override { return static_cast<int>(elements_.size()); }
+  void element_dofs(int e, std::vector<int>* dofs) const override;
+  void element_matrices(int e, Eigen::MatrixXd* K, Eigen::MatrixXd* M) const override;
+
+  /// DOF types of element e at each of its nodes, in element-matrix order (node-major).
+  std::vector<std::pair<int, Dof>> element_dof_types(int e) const;
+  /// The element's matrices split by property (see ElementParts).
+  ElementParts element_parts(int e) const;
+
+  /// Geometric rigid-body motions restricted to the free DOFs: columns are unit translations along x, y, z and
+  /// unit rotations about x, y, z through the centroid of the nodes; columns that vanish on the free DOFs
+  /// (e.g. z motions of a plane model) are left out. Labels in `labels` if non-null.
+  Eigen::MatrixXd rigid_body_motions(std::vector<std::string>* labels = nullptr) const;
+  /// The rigid-body motions that supports and springs leave free (an orthonormal basis of null(K) within the
+  /// span of rigid_body_motions()), judged per motion by ||K r|| against || |K| |r| || (rounding level), not by
+  /// any threshold on eigenvalues. Empty for a supported structure; 3 columns for a free-free plane frame.
+  /// Each column gets a description in `descriptions` ("translation y", "rotation about z", ...).
+  Eigen::MatrixXd free_rigid_body_modes(std::vector<std::string>* descriptions = nullptr) const;
+
+ private:
+  void require_finalized(const char* what) const;
+  void member_local(int e, internal::MemberLocal* loc, Eigen::MatrixXd* T) const;
+  std::vector<Node> nodes_;
+  std::vector<Material> materials_;
+  std::vector<Section> sections_;
+  std::vector<Element> elements_;
+  std::unordered_map<int, int> node_of_id_, element_of_id_;
+  std::vector<std::pair<int, DofMask>> restraints_;  // (node id, dofs)
+  std::vector<std::array<int, 2>> element_nodes_;
+  std::vector<DofMask> point_mass_dofs_;  // per element: DOFs a point mass acts on (set at finalize)
+  MassType mass_type_ = MassType::Consistent;
+  bool rotary_inertia_ = false;
+  bool free_free_ = false;
+  bool finalized_ = false;
+  DofMap dofs_;
+  std::vector<std::string> warnings_;
+};
+
+}  // namespace dynid

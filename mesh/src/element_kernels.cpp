@@ -1,0 +1,141 @@
+// Element matrices of the Euler-Bernoulli beam and frame elements (Chandrupatla & Belegundu, "Introduction to
+// Finite Elements in Engineering", ch. 8; Przemieniecki, "Theory of Matrix Structural Analysis", for 3D).
+#include "internal/element_kernels.hpp"
+
+#include <array>
+#include <cmath>
+
+namespace dynid::internal {
+namespace {
+
+// Bending stiffness block for (w1, t1, w2, t2) with the convention w' = +t (x-y plane).
+// For the x-z plane (w' = -t) the sign of the off-diagonal L terms flips: pass s = -1.
+void bending_k(double EI, double L, double s, Eigen::Matrix4d* k) {
+  const double c = EI / (L * L * L), L2 = L * L;
+  *k << 12, 6 * L * s, -12, 6 * L * s,    //
+      6 * L * s, 4 * L2, -6 * L * s, 2 * L2,  //
+      -12, -6 * L * s, 12, -6 * L * s,    //
+      6 * L * s, 2 * L2, -6 * L * s, 4 * L2;
+  *k *= c;
+}
+
+void bending_m(double rhoA, double L, double s, Eigen::Matrix4d* m) {
+  const double c = rhoA * L / 420.0, L2 = L * L;
+  *m << 156, 22 * L * s, 54, -13 * L * s,  //
+      22 * L * s, 4 * L2, 13 * L * s, -3 * L2,  //
+      54, 13 * L * s, 156, -22 * L * s,    //
+      -13 * L * s, -3 * L2, -22 * L * s, 4 * L2;
+  *m *= c;
+}
+
+// Rayleigh rotary inertia of a cubic-Hermite beam.
+void rotary_m(double rhoI, double L, double s, Eigen::Matrix4d* m) {
+  const double c = rhoI / (30.0 * L), L2 = L * L;
+  *m << 36, 3 * L * s, -36, 3 * L * s,  //
+      3 * L * s, 4 * L2, -3 * L * s, -L2,  //
+      -36, -3 * L * s, 36, -3 * L * s,   //
+      3 * L * s, -L2, -3 * L * s, 4 * L2;
+  *m *= c;
+}
+
+template <class Idx>
+void scatter4(const Eigen::Matrix4d& b, const Idx& idx, Eigen::MatrixXd* out) {
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) (*out)(idx[i], idx[j]) += b(i, j);
+}
+
+void scatter_bar(double k, int i, int j, Eigen::MatrixXd* out) {
+  (*out)(i, i) += k;
+  (*out)(j, j) += k;
+  (*out)(i, j) -= k;
+  (*out)(j, i) -= k;
+}
+
+void scatter_bar_mass(double m, int i, int j, bool lumped, Eigen::MatrixXd* out) {
+  if (lumped) {
+    (*out)(i, i) += m / 2;
+    (*out)(j, j) += m / 2;
+  } else {
+    (*out)(i, i) += m / 3;
+    (*out)(j, j) += m / 3;
+    (*out)(i, j) += m / 6;
+    (*out)(j, i) += m / 6;
+  }
+}
+
+void zero_all(int n, MemberLocal* o) {
+  for (Eigen::MatrixXd* m : {&o->Ka, &o->Kb, &o->Kt, &o->Mt, &o->Mr}) m->setZero(n, n);
+}
+
+}  // namespace
+
+void frame2d_local(const MemberProps& p, MemberLocal* o) {
+  zero_all(6, o);
+  const double L = p.L;
+  scatter_bar(p.EA / L, 0, 3, &o->Ka);
+  const std::array<int, 4> bi{{1, 2, 4, 5}};
+  Eigen::Matrix4d b;
+  bending_k(p.EIz, L, 1.0, &b);
+  scatter4(b, bi, &o->Kb);
+  const double m = p.rhoA * L;
+  scatter_bar_mass(m, 0, 3, p.lumped, &o->Mt);
+  if (p.lumped) {
+    o->Mt(1, 1) += m / 2;
+    o->Mt(4, 4) += m / 2;
+  } else {
+    bending_m(p.rhoA, L, 1.0, &b);
+    scatter4(b, bi, &o->Mt);
+    if (p.rotary) {
+      rotary_m(p.rhoIz, L, 1.0, &b);
+      scatter4(b, bi, &o->Mr);
+    }
+  }
+}
+
+void frame3d_local(const MemberProps& p, MemberLocal* o) {
+  zero_all(12, o);
+  const double L = p.L;
+  scatter_bar(p.EA / L, 0, 6, &o->Ka);
+  scatter_bar(p.GJ / L, 3, 9, &o->Kt);
+  const std::array<int, 4> xy{{1, 5, 7, 11}}, xz{{2, 4, 8, 10}};
+  Eigen::Matrix4d b;
+  bending_k(p.EIz, L, 1.0, &b);
+  scatter4(b, xy, &o->Kb);
+  bending_k(p.EIy, L, -1.0, &b);
+  scatter4(b, xz, &o->Kb);
+  const double m = p.rhoA * L;
+  scatter_bar_mass(m, 0, 6, p.lumped, &o->Mt);
+  // Torsional inertia (polar moment Iy + Iz) is always included: without it twisting DOFs would be massless.
+  scatter_bar_mass((p.rhoIy + p.rhoIz) * L, 3, 9, p.lumped, &o->Mr);
+  if (p.lumped) {
+    for (int i : {1, 2, 7, 8}) o->Mt(i, i) += m / 2;
+  } else {
+    bending_m(p.rhoA, L, 1.0, &b);
+    scatter4(b, xy, &o->Mt);
+    bending_m(p.rhoA, L, -1.0, &b);
+    scatter4(b, xz, &o->Mt);
+    if (p.rotary) {
+      rotary_m(p.rhoIz, L, 1.0, &b);
+      scatter4(b, xy, &o->Mr);
+      rotary_m(p.rhoIy, L, -1.0, &b);
+      scatter4(b, xz, &o->Mr);
+    }
+  }
+}
+
+bool frame3d_axes(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& orientation,
+                  Eigen::Matrix3d* R) {
+  const Eigen::Vector3d ex = (b - a).normalized();
+  Eigen::Vector3d v = orientation;
+  if (v.squaredNorm() == 0.0) v = std::abs(ex.z()) > 0.999 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d ey = v.cross(ex);
+  if (ey.norm() < 1e-8 * v.norm()) return false;
+  ey.normalize();
+  const Eigen::Vector3d ez = ex.cross(ey);
+  R->row(0) = ex;
+  R->row(1) = ey;
+  R->row(2) = ez;
+  return true;
+}
+
+}  // namespace dynid::internal

@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# dynid set-up: installs the Debian 12 packages dynid needs (only those missing), then configures and builds
+# a Release tree in ./build (override with DYNID_BUILD_DIR). Safe to run again: it skips what is already done.
+#   scripts/setup.sh            install + configure + build
+#   scripts/setup.sh --deps     install packages only
+set -euo pipefail
+here=$(cd "$(dirname "$0")/.." && pwd)
+build=${DYNID_BUILD_DIR:-$here/build}
+
+packages=(
+  build-essential cmake git pkg-config
+  libeigen3-dev libsuitesparse-dev libmetis-dev libspectra-dev libceres-dev libgoogle-glog-dev libgflags-dev
+  libopenblas-dev liblapack-dev libgtest-dev libgmock-dev libbenchmark-dev
+  nlohmann-json3-dev libyaml-cpp-dev libcli11-dev libfmt-dev libfftw3-dev
+  libplplot-dev plplot-driver-cairo
+  python3 python3-numpy python3-scipy python3-slepc4py python3-petsc4py python3-plotly
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "dynid setup: installing ${#missing[@]} Debian packages: ${missing[*]}"
+  SUDO=""
+  if [ "$(id -u)" != 0 ]; then
+    command -v sudo >/dev/null || { echo "dynid setup: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+    SUDO=sudo
+  fi
+  $SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -qq
+  $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+# Debian's default BLAS is the slow reference one; CHOLMOD's supernodal factorization needs an optimized BLAS.
+blas=$(readlink -f /usr/lib/x86_64-linux-gnu/libblas.so.3 2>/dev/null || true)
+case "$blas" in
+  *openblas*) ;;
+  *) echo "dynid setup: warning: libblas.so.3 resolves to '$blas', not OpenBLAS; CHOLMOD will be slow." \
+          "Select it with: update-alternatives --config libblas.so.3-x86_64-linux-gnu" >&2 ;;
+esac
+
+[ "${1:-}" = "--deps" ] && exit 0
+
+jobs=$(nproc 2>/dev/null || echo 2)
+cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release ${DYNID_CMAKE_ARGS:-} >/dev/null
+cmake --build "$build" -j "$jobs"

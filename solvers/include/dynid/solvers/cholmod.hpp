@@ -1,0 +1,52 @@
+// dynid/solvers/cholmod.hpp -- an owned CHOLMOD factorization of a symmetric sparse matrix.
+#pragma once
+
+#include <memory>
+
+#include "dynid/solvers/sparse.hpp"
+
+namespace dynid {
+
+/// A CHOLMOD factorization that owns its own cholmod_common (no globals: two factorizations can live in
+/// different threads). The symbolic analysis (fill-reducing ordering, elimination tree, supernodes) is done once
+/// by analyze(); factorize() may then be called any number of times for matrices with the same pattern
+/// (e.g. K - sigma M for several shifts, or K(theta) during updating).
+///
+/// Only the upper triangle of the matrix is read (the full symmetric storage of SparseMatrix is accepted).
+/// Not thread-safe: one object, one thread at a time (solve() reuses workspace).
+class CholmodFactor {
+ public:
+  enum class Kind {
+    kSupernodalLLt,  ///< supernodal Cholesky L L^T (BLAS-3); requires a positive definite matrix
+    kSimplicialLDLt  ///< simplicial L D L^T; works for indefinite matrices and gives the inertia
+  };
+  explicit CholmodFactor(Kind kind = Kind::kSupernodalLLt);
+  ~CholmodFactor();
+  CholmodFactor(const CholmodFactor&) = delete;
+  CholmodFactor& operator=(const CholmodFactor&) = delete;
+
+  /// Ordering and symbolic factorization for A's pattern.
+  void analyze(const SparseMatrix& A);
+  /// Numeric factorization of A (A must have the analyzed pattern). Returns false on breakdown: LL^T of a matrix
+  /// that is not positive definite, or a zero pivot in LDL^T; failed_index() then names the (original) row.
+  bool factorize(const SparseMatrix& A);
+  /// x = A^{-1} b (b and x may alias).
+  void solve(const double* b, double* x) const;
+  /// Row/column of A (original numbering) at which the last factorize() broke down, or -1.
+  int failed_index() const { return failed_; }
+  /// LDL^T only: the number of negative entries of D, i.e. the number of negative eigenvalues of A.
+  int negative_pivots() const;
+  long long factor_nonzeros() const;
+  double factor_flops() const;  ///< floating point operations of the last numeric factorization
+  int rows() const { return n_; }
+  Kind kind() const { return kind_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  Kind kind_;
+  int n_ = 0;
+  int failed_ = -1;
+};
+
+}  // namespace dynid

@@ -1,0 +1,93 @@
+// dynid/solvers/eigen.hpp -- the generalized symmetric eigenproblem K phi = lambda M phi.
+//
+// Sparse path: shift-invert Lanczos (Spectra SymGEigsShiftSolver, ShiftInvert mode) on a CHOLMOD factorization
+// of K - sigma M; the operator is (K - sigma M)^{-1} M in the M inner product, so M may be singular (massless
+// DOFs): those directions map to infinite eigenvalues, which shift-invert never returns.
+// Dense path: LAPACK-style dense solvers (Eigen), for small models and as an independent cross-check.
+//
+// Modes are mass-normalised (phi^T M phi = 1), sorted by eigenvalue, with a sign convention (the entry of
+// largest magnitude is positive). Rigid-body modes come first and are flagged.
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "dynid/solvers/sparse.hpp"
+
+namespace dynid {
+
+struct EigenOptions {
+  /// Number of lowest modes wanted, rigid-body modes included. Ignored in band mode.
+  int num_modes = 10;
+  /// Band mode: all eigenvalues lambda = omega^2 in [band_lo, band_hi] (both set, band_lo >= 0).
+  double band_lo = std::numeric_limits<double>::quiet_NaN();
+  double band_hi = std::numeric_limits<double>::quiet_NaN();
+  /// Shift sigma. NaN = automatic: 0 for a supported structure; for a free-free one a small negative shift
+  /// -sqrt(eps) * max_i(K_ii / M_ii) (K - sigma M must be positive definite for the supernodal LL^T).
+  double shift = std::numeric_limits<double>::quiet_NaN();
+  /// A basis (n x r) of the rigid-body motions null(K), e.g. Model::free_rigid_body_modes(). These modes are
+  /// returned exactly (lambda = Rayleigh quotient, ~0) and deflated from the Lanczos run. Empty: if K turns out
+  /// singular, `allow_singular_stiffness` decides.
+  Eigen::MatrixXd rigid_body_basis;
+  /// With no rigid basis: if K is singular, either fail naming the DOF (false) or shift below zero and report
+  /// zero-energy modes as rigid by their residual ||K phi|| <= rigid_residual_tolerance * ||K||_1 ||phi||.
+  bool allow_singular_stiffness = false;
+  double rigid_residual_tolerance = 1e-9;
+  /// Lanczos basis size (Spectra's ncv); 0 = min(n, max(2 nev + 1, nev + 20)).
+  int subspace = 0;
+  /// Restart limit and relative Ritz-value tolerance: stop when every wanted Ritz value theta satisfies
+  /// |theta - theta_exact| <= tolerance * |theta| (Spectra's criterion).
+  int max_restarts = 500;
+  double tolerance = 1e-10;
+  enum class Method { kAuto, kSparse, kDense };
+  /// kAuto: dense for n <= 300 (or when the wanted modes approach n), sparse otherwise.
+  Method method = Method::kAuto;
+  /// Progress callback (stage name, fraction in [0, 1] or -1 when unknown). Called from the calling thread.
+  std::function<void(std::string_view stage, double fraction)> progress;
+
+  bool IsValid(std::string* why) const;
+};
+
+enum class EigenStatus { kSuccess, kNotConverged, kFactorizationFailed, kInvalidInput };
+
+struct EigenSummary {
+  EigenStatus status = EigenStatus::kInvalidInput;
+  std::string message;
+  std::string method;     ///< "sparse shift-invert Lanczos" or "dense"
+  double shift = 0;       ///< sigma used
+  int failed_dof = -1;    ///< on kFactorizationFailed: the DOF where the factorization broke down
+  long long factor_nonzeros = 0;
+  double factor_flops = 0;
+  int solves = 0;         ///< triangular solve pairs (operator applications)
+  int restarts = 0;
+  int num_rigid = 0;
+  double time_analyze = 0, time_factorize = 0, time_lanczos = 0;  ///< seconds
+  double max_residual = 0;
+  bool ok() const { return status == EigenStatus::kSuccess; }
+  std::string BriefReport() const;
+  std::string FullReport() const;
+};
+
+struct EigenSolution {
+  Eigen::VectorXd eigenvalues;      ///< lambda = omega^2, ascending
+  Eigen::MatrixXd modes;            ///< n x m, mass-normalised
+  std::vector<char> rigid_body;     ///< per mode
+  Eigen::VectorXd residuals;        ///< ||K phi - lambda M phi|| / (||K||_1 + |lambda| ||M||_1) / ||phi||
+  EigenSummary summary;
+};
+
+/// Solves K phi = lambda M phi for the lowest num_modes modes (or a band). Never throws for numerical failures:
+/// they come back in summary.status / message. Throws InputError for invalid options or mismatched matrices.
+EigenSolution solve_eigen(const SparseMatrix& K, const SparseMatrix& M, const EigenOptions& options);
+
+/// Dense reference path (O(n^3)); the same options and result conventions.
+EigenSolution solve_eigen_dense(const Eigen::MatrixXd& K, const Eigen::MatrixXd& M, const EigenOptions& options);
+
+/// Relative residual ||K phi - lambda M phi|| / ((||K||_1 + |lambda| ||M||_1) ||phi||) of one mode.
+double eigen_residual(const SparseMatrix& K, const SparseMatrix& M, double lambda, const Eigen::VectorXd& phi);
+
+}  // namespace dynid

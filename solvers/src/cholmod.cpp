@@ -1,0 +1,131 @@
+#include "dynid/solvers/cholmod.hpp"
+
+#include <cholmod.h>
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+
+#include "dynid/mesh/error.hpp"
+
+namespace dynid {
+
+struct CholmodFactor::Impl {
+  cholmod_common c;
+  cholmod_factor* L = nullptr;
+  mutable cholmod_dense* X = nullptr;
+  mutable cholmod_dense* Y = nullptr;
+  mutable cholmod_dense* E = nullptr;
+  Impl() { cholmod_start(&c); }
+  ~Impl() {
+    if (L) cholmod_free_factor(&L, &c);
+    for (cholmod_dense** d : {&X, &Y, &E})
+      if (*d) cholmod_free_dense(d, &c);
+    cholmod_finish(&c);
+  }
+};
+
+namespace {
+// A read-only CHOLMOD view of an Eigen CSC matrix; stype = 1: only the upper triangle is used.
+cholmod_sparse view(const SparseMatrix& A) {
+  cholmod_sparse s;
+  std::memset(&s, 0, sizeof(s));
+  s.nrow = static_cast<size_t>(A.rows());
+  s.ncol = static_cast<size_t>(A.cols());
+  s.nzmax = static_cast<size_t>(A.nonZeros());
+  s.p = const_cast<int*>(A.outerIndexPtr());
+  s.i = const_cast<int*>(A.innerIndexPtr());
+  s.x = const_cast<double*>(A.valuePtr());
+  s.stype = 1;
+  s.itype = CHOLMOD_INT;
+  s.xtype = CHOLMOD_REAL;
+  s.dtype = CHOLMOD_DOUBLE;
+  s.sorted = 1;
+  s.packed = 1;
+  return s;
+}
+}  // namespace
+
+CholmodFactor::CholmodFactor(Kind kind) : impl_(std::make_unique<Impl>()), kind_(kind) {
+  cholmod_common& c = impl_->c;
+  c.print = 0;
+  c.error_handler = nullptr;
+  if (kind == Kind::kSupernodalLLt) {
+    c.supernodal = CHOLMOD_SUPERNODAL;
+    c.final_ll = 1;
+  } else {
+    c.supernodal = CHOLMOD_SIMPLICIAL;
+    c.final_ll = 0;
+  }
+  c.quick_return_if_not_posdef = 1;
+}
+
+CholmodFactor::~CholmodFactor() = default;
+
+void CholmodFactor::analyze(const SparseMatrix& A) {
+  if (A.rows() != A.cols()) throw InputError("CholmodFactor: matrix is not square");
+  if (!A.isCompressed()) throw InputError("CholmodFactor: matrix must be compressed");
+  cholmod_common& c = impl_->c;
+  if (impl_->L) cholmod_free_factor(&impl_->L, &c);
+  n_ = static_cast<int>(A.rows());
+  cholmod_sparse s = view(A);
+  impl_->L = cholmod_analyze(&s, &c);
+  if (!impl_->L || c.status < CHOLMOD_OK)
+    throw NumericalError("CHOLMOD analysis failed (status " + std::to_string(c.status) +
+                         (c.status == CHOLMOD_OUT_OF_MEMORY ? ": out of memory" : "") + ")");
+}
+
+bool CholmodFactor::factorize(const SparseMatrix& A) {
+  if (!impl_->L) throw InternalError("CholmodFactor::factorize called before analyze");
+  if (A.rows() != n_) throw InputError("CholmodFactor: matrix size differs from the analyzed one");
+  cholmod_common& c = impl_->c;
+  cholmod_sparse s = view(A);
+  failed_ = -1;
+  const int ok = cholmod_factorize(&s, impl_->L, &c);
+  if (!ok && c.status != CHOLMOD_NOT_POSDEF)
+    throw NumericalError("CHOLMOD factorization failed (status " + std::to_string(c.status) +
+                         (c.status == CHOLMOD_OUT_OF_MEMORY ? ": out of memory" : "") + ")");
+  cholmod_factor* L = impl_->L;
+  if (c.status == CHOLMOD_NOT_POSDEF || L->minor < L->n) {
+    const size_t k = std::min<size_t>(L->minor, L->n - 1);
+    failed_ = L->Perm ? static_cast<int*>(L->Perm)[k] : static_cast<int>(k);
+    return false;
+  }
+  return true;
+}
+
+void CholmodFactor::solve(const double* b, double* x) const {
+  cholmod_common& c = const_cast<cholmod_common&>(impl_->c);
+  cholmod_dense B;
+  std::memset(&B, 0, sizeof(B));
+  B.nrow = static_cast<size_t>(n_);
+  B.ncol = 1;
+  B.nzmax = static_cast<size_t>(n_);
+  B.d = static_cast<size_t>(n_);
+  B.x = const_cast<double*>(b);
+  B.xtype = CHOLMOD_REAL;
+  B.dtype = CHOLMOD_DOUBLE;
+  if (!cholmod_solve2(CHOLMOD_A, impl_->L, &B, nullptr, &impl_->X, nullptr, &impl_->Y, &impl_->E, &c))
+    throw NumericalError("CHOLMOD solve failed (status " + std::to_string(c.status) + ")");
+  std::memcpy(x, impl_->X->x, sizeof(double) * static_cast<size_t>(n_));
+}
+
+int CholmodFactor::negative_pivots() const {
+  const cholmod_factor* L = impl_->L;
+  if (!L || L->is_ll || L->is_super) throw InternalError("negative_pivots needs a simplicial LDL^T factor");
+  const int* p = static_cast<const int*>(L->p);
+  const double* x = static_cast<const double*>(L->x);
+  int neg = 0;
+  for (size_t j = 0; j < L->n; ++j)
+    if (x[p[j]] < 0) ++neg;
+  return neg;
+}
+
+long long CholmodFactor::factor_nonzeros() const {
+  const cholmod_common& c = impl_->c;
+  return static_cast<long long>(c.lnz);
+}
+
+double CholmodFactor::factor_flops() const { return impl_->c.fl; }
+
+}  // namespace dynid

@@ -1,0 +1,526 @@
+#include "dynid/solvers/eigen.hpp"
+
+#include <Eigen/Dense>
+#include <Spectra/SymGEigsShiftSolver.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <random>
+#include <sstream>
+
+#include "dynid/mesh/error.hpp"
+#include "dynid/solvers/cholmod.hpp"
+
+namespace dynid {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+void report(const EigenOptions& o, std::string_view stage, double f) {
+  if (o.progress) o.progress(stage, f);
+}
+
+// (K - sigma M)^{-1} x on a CHOLMOD factor, meeting Spectra's operator contract (rows, cols, set_shift,
+// perform_op). The factorization is done by the caller before the solver is built, so that failures are
+// reported with the DOF; set_shift only checks the shift. With a deflation basis Phi (M-orthonormal) the result
+// is projected: y <- y - Phi (M Phi)^T y, which removes the rigid-body directions exactly.
+class ShiftInvertOperator {
+ public:
+  using Scalar = double;
+  ShiftInvertOperator(const CholmodFactor& f, double sigma, const Eigen::MatrixXd& Phi, const Eigen::MatrixXd& MPhi)
+      : f_(f), sigma_(sigma), Phi_(Phi), MPhi_(MPhi) {}
+  Eigen::Index rows() const { return f_.rows(); }
+  Eigen::Index cols() const { return f_.rows(); }
+  void set_shift(double sigma) {
+    if (sigma != sigma_) throw InternalError("ShiftInvertOperator: shift differs from the factorized one");
+  }
+  void perform_op(const double* x, double* y) const {
+    f_.solve(x, y);
+    ++count_;
+    if (Phi_.cols() > 0) {
+      Eigen::Map<Eigen::VectorXd> yv(y, f_.rows());
+      const Eigen::VectorXd c = MPhi_.transpose() * yv;
+      yv.noalias() -= Phi_ * c;
+    }
+  }
+  int count() const { return count_; }
+
+ private:
+  const CholmodFactor& f_;
+  double sigma_;
+  const Eigen::MatrixXd& Phi_;
+  const Eigen::MatrixXd& MPhi_;
+  mutable int count_ = 0;
+};
+
+// y = M x with M stored in full; Spectra's B operator.
+class MassOperator {
+ public:
+  using Scalar = double;
+  explicit MassOperator(const SparseMatrix& M) : M_(M) {}
+  Eigen::Index rows() const { return M_.rows(); }
+  Eigen::Index cols() const { return M_.cols(); }
+  void perform_op(const double* x, double* y) const { symmetric_multiply(M_, x, y); }
+
+ private:
+  const SparseMatrix& M_;
+};
+
+// Makes the entry of largest magnitude of each column positive (ties: the first one).
+void normalize_signs(Eigen::MatrixXd* V) {
+  for (Eigen::Index j = 0; j < V->cols(); ++j) {
+    Eigen::Index imax = 0;
+    V->col(j).cwiseAbs().maxCoeff(&imax);
+    if ((*V)(imax, j) < 0) V->col(j) *= -1.0;
+  }
+}
+
+// M-orthonormalises the columns of B (n x r): returns Phi with Phi^T M Phi = I spanning the same space.
+Eigen::MatrixXd m_orthonormalize(const Eigen::MatrixXd& B, const Eigen::MatrixXd& MB) {
+  const Eigen::MatrixXd G = B.transpose() * MB;
+  const Eigen::LLT<Eigen::MatrixXd> llt(0.5 * (G + G.transpose()));
+  if (llt.info() != Eigen::Success)
+    throw InputError("rigid-body basis: the rigid-body motions have no mass (B^T M B is not positive definite)");
+  // G = L L^T  =>  Phi = B L^{-T} = (L^{-1} B^T)^T satisfies Phi^T M Phi = L^{-1} G L^{-T} = I.
+  return llt.matrixL().solve(B.transpose()).transpose();
+}
+
+double max_stiffness_to_mass(const Eigen::VectorXd& kd, const Eigen::VectorXd& md) {
+  double r = 0;
+  for (Eigen::Index i = 0; i < kd.size(); ++i)
+    if (md[i] > 0) r = std::max(r, std::abs(kd[i]) / md[i]);
+  if (r == 0) r = kd.cwiseAbs().maxCoeff();
+  return r > 0 ? r : 1.0;
+}
+
+// Sorts modes by eigenvalue and applies the sign convention.
+void finish(EigenSolution* s) {
+  const Eigen::Index m = s->eigenvalues.size();
+  std::vector<Eigen::Index> order(m);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](Eigen::Index a, Eigen::Index b) {
+    if (s->rigid_body[a] != s->rigid_body[b]) return s->rigid_body[a] > s->rigid_body[b];
+    return s->eigenvalues[a] < s->eigenvalues[b];
+  });
+  EigenSolution o;
+  o.eigenvalues.resize(m);
+  o.modes.resize(s->modes.rows(), m);
+  o.rigid_body.resize(m);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    o.eigenvalues[k] = s->eigenvalues[order[k]];
+    o.modes.col(k) = s->modes.col(order[k]);
+    o.rigid_body[k] = s->rigid_body[order[k]];
+  }
+  normalize_signs(&o.modes);
+  s->eigenvalues = std::move(o.eigenvalues);
+  s->modes = std::move(o.modes);
+  s->rigid_body = std::move(o.rigid_body);
+}
+
+void check_inputs(Eigen::Index kr, Eigen::Index kc, Eigen::Index mr, Eigen::Index mc, const EigenOptions& o) {
+  std::string why;
+  if (!o.IsValid(&why)) throw InputError("eigen-solve options: " + why);
+  if (kr != kc || mr != mc || kr != mr)
+    throw InputError("eigen-solve: K is " + std::to_string(kr) + "x" + std::to_string(kc) + " but M is " +
+                     std::to_string(mr) + "x" + std::to_string(mc) + "; both must be square and of the same size");
+  if (o.rigid_body_basis.size() > 0 && o.rigid_body_basis.rows() != kr)
+    throw InputError("eigen-solve: rigid-body basis has " + std::to_string(o.rigid_body_basis.rows()) +
+                     " rows, the matrices " + std::to_string(kr));
+}
+
+void check_finite(const double* v, Eigen::Index n, const char* name) {
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (!std::isfinite(v[i])) throw InputError(std::string("eigen-solve: ") + name + " holds a NaN or Inf entry");
+}
+
+bool in_band(double lam, const EigenOptions& o) { return lam >= o.band_lo && lam <= o.band_hi; }
+bool band_mode(const EigenOptions& o) { return !std::isnan(o.band_lo); }
+
+}  // namespace
+
+bool EigenOptions::IsValid(std::string* why) const {
+  auto fail = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
+  const bool lo = !std::isnan(band_lo), hi = !std::isnan(band_hi);
+  if (lo != hi) return fail("band needs both band_lo and band_hi");
+  if (lo && !(band_lo >= 0 && band_hi > band_lo && std::isfinite(band_hi)))
+    return fail("band must satisfy 0 <= band_lo < band_hi < inf");
+  if (!lo && num_modes < 1) return fail("num_modes must be >= 1");
+  if (!(tolerance > 0 && tolerance < 1)) return fail("tolerance must be in (0, 1)");
+  if (max_restarts < 1) return fail("max_restarts must be >= 1");
+  if (subspace < 0) return fail("subspace must be >= 0");
+  if (!std::isnan(shift) && !std::isfinite(shift)) return fail("shift must be finite");
+  if (!(rigid_residual_tolerance > 0)) return fail("rigid_residual_tolerance must be > 0");
+  return true;
+}
+
+std::string EigenSummary::BriefReport() const {
+  std::ostringstream s;
+  static const char* names[] = {"success", "not converged", "factorization failed", "invalid input"};
+  s << method << ": " << names[static_cast<int>(status)];
+  if (!message.empty()) s << " (" << message << ")";
+  return s.str();
+}
+
+std::string EigenSummary::FullReport() const {
+  std::ostringstream s;
+  s << BriefReport() << "\n"
+    << "  shift sigma          " << shift << "\n"
+    << "  rigid-body modes     " << num_rigid << "\n"
+    << "  factor nonzeros      " << factor_nonzeros << "\n"
+    << "  factor flops         " << factor_flops << "\n"
+    << "  triangular solves    " << solves << "\n"
+    << "  Lanczos restarts     " << restarts << "\n"
+    << "  time analyze (s)     " << time_analyze << "\n"
+    << "  time factorize (s)   " << time_factorize << "\n"
+    << "  time Lanczos (s)     " << time_lanczos << "\n"
+    << "  max rel. residual    " << max_residual << "\n";
+  return s.str();
+}
+
+double eigen_residual(const SparseMatrix& K, const SparseMatrix& M, double lambda, const Eigen::VectorXd& phi) {
+  const Eigen::Index n = phi.size();
+  Eigen::VectorXd kp(n), mp(n);
+  symmetric_multiply(K, phi.data(), kp.data());
+  symmetric_multiply(M, phi.data(), mp.data());
+  const double den = (norm1(K) + std::abs(lambda) * norm1(M)) * phi.norm();
+  return den > 0 ? (kp - lambda * mp).norm() / den : 0.0;
+}
+
+EigenSolution solve_eigen(const SparseMatrix& K, const SparseMatrix& M, const EigenOptions& opt) {
+  check_inputs(K.rows(), K.cols(), M.rows(), M.cols(), opt);
+  check_finite(K.valuePtr(), K.nonZeros(), "K");
+  check_finite(M.valuePtr(), M.nonZeros(), "M");
+  const Eigen::Index n = K.rows();
+  const bool band = band_mode(opt);
+  const Eigen::Index r = opt.rigid_body_basis.cols();
+  const bool want_dense = opt.method == EigenOptions::Method::kDense ||
+                          (opt.method == EigenOptions::Method::kAuto &&
+                           (n <= 300 || (!band && 2 * static_cast<Eigen::Index>(opt.num_modes) + 20 > n)));
+  if (want_dense) return solve_eigen_dense(Eigen::MatrixXd(K), Eigen::MatrixXd(M), opt);
+
+  // Both matrices must share one pattern, so that K - sigma M is a sum of value arrays.
+  SparseMatrix Ku = K, Mu = M;
+  if (K.nonZeros() != M.nonZeros() ||
+      !std::equal(K.innerIndexPtr(), K.innerIndexPtr() + K.nonZeros(), M.innerIndexPtr()) ||
+      !std::equal(K.outerIndexPtr(), K.outerIndexPtr() + n + 1, M.outerIndexPtr())) {
+    const SparseMatrix P = (K.cwiseAbs() + M.cwiseAbs());  // union pattern
+    Ku = P * 0.0 + K;
+    Mu = P * 0.0 + M;
+    Ku.makeCompressed();
+    Mu.makeCompressed();
+  }
+
+  EigenSolution sol;
+  EigenSummary& sum = sol.summary;
+  sum.method = "sparse shift-invert Lanczos";
+  auto t0 = Clock::now();
+
+  // Rigid-body modes from the supplied null-space basis: exact, M-orthonormal, deflated from the Lanczos run.
+  Eigen::MatrixXd Phi(n, 0), MPhi(n, 0);
+  if (r > 0) {
+    Eigen::MatrixXd MB(n, r);
+    for (Eigen::Index j = 0; j < r; ++j)
+      symmetric_multiply(Mu, opt.rigid_body_basis.col(j).data(), MB.col(j).data());
+    Phi = m_orthonormalize(opt.rigid_body_basis, MB);
+    MPhi.resize(n, r);
+    for (Eigen::Index j = 0; j < r; ++j) symmetric_multiply(Mu, Phi.col(j).data(), MPhi.col(j).data());
+  }
+
+  const Eigen::VectorXd kd = Ku.diagonal(), md = Mu.diagonal();
+  const double s0 = std::sqrt(std::numeric_limits<double>::epsilon()) * max_stiffness_to_mass(kd, md);
+  SparseMatrix A = Ku;
+  auto form = [&](double sigma) {
+    Eigen::Map<Eigen::VectorXd>(A.valuePtr(), A.nonZeros()) =
+        Eigen::Map<const Eigen::VectorXd>(Ku.valuePtr(), Ku.nonZeros()) -
+        sigma * Eigen::Map<const Eigen::VectorXd>(Mu.valuePtr(), Mu.nonZeros());
+  };
+
+  CholmodFactor F(band ? CholmodFactor::Kind::kSimplicialLDLt : CholmodFactor::Kind::kSupernodalLLt);
+  report(opt, "analyze", -1);
+  F.analyze(Ku);
+  sum.time_analyze = seconds_since(t0);
+
+  auto factor_at = [&](double sigma) {
+    auto tf = Clock::now();
+    form(sigma);
+    report(opt, "factorize", -1);
+    const bool ok = F.factorize(A);
+    sum.time_factorize += seconds_since(tf);
+    sum.factor_nonzeros = F.factor_nonzeros();
+    sum.factor_flops = F.factor_flops();
+    return ok;
+  };
+  auto fail_factor = [&](double sigma, const std::string& why) {
+    sum.status = EigenStatus::kFactorizationFailed;
+    sum.shift = sigma;
+    sum.failed_dof = F.failed_index();
+    sum.message = why;
+    return sol;
+  };
+
+  double sigma = 0;
+  int nev = 0;
+  int band_count = 0;
+  Spectra::SortRule selection = Spectra::SortRule::LargestAlge;
+  if (!band) {
+    nev = opt.num_modes - static_cast<int>(r);
+    if (!std::isnan(opt.shift)) {
+      sigma = opt.shift;
+    } else {
+      sigma = (r > 0) ? -s0 : 0.0;
+    }
+    if (nev > 0) {
+      bool ok = factor_at(sigma);
+      if (!ok && std::isnan(opt.shift) && sigma == 0.0 && opt.allow_singular_stiffness) {
+        sigma = -s0;
+        ok = factor_at(sigma);
+      }
+      if (!ok) {
+        if (sigma == 0.0)
+          return fail_factor(sigma, "K is singular: the structure is a mechanism or is not supported (Cholesky "
+                                    "broke down at this DOF)");
+        return fail_factor(sigma, "K - sigma M is not positive definite at this DOF: a mechanism with no mass, "
+                                  "or the shift lies above the lowest eigenvalue");
+      }
+    }
+  } else {
+    // Spectrum slicing: Sylvester's inertia of L D L^T(K - x M) counts the eigenvalues below x.
+    auto count_below = [&](double x, int* count) {
+      for (int attempt = 0; attempt < 4; ++attempt) {
+        if (factor_at(x)) {
+          *count = F.negative_pivots();
+          return true;
+        }
+        x -= (std::abs(x) + s0) * 1e-8;  // exactly on an eigenvalue: a zero pivot; step off it
+      }
+      return false;
+    };
+    int below_lo = 0, below_hi = 0;
+    const double lo = opt.band_lo > 0 ? opt.band_lo : -s0;
+    if (!count_below(lo, &below_lo) || !count_below(opt.band_hi, &below_hi))
+      return fail_factor(lo, "L D L^T of K - x M broke down while counting eigenvalues in the band");
+    band_count = below_hi - below_lo;
+    const int rigid_in_band = opt.band_lo <= 0 ? static_cast<int>(r) : 0;
+    nev = band_count - rigid_in_band;
+    if (band_count > 2000)
+      return fail_factor(lo, "the band holds " + std::to_string(band_count) +
+                                 " modes; split it into narrower bands (at most 2000 modes per solve)");
+    sigma = !std::isnan(opt.shift) ? opt.shift : 0.5 * (std::max(opt.band_lo, 0.0) + opt.band_hi);
+    if (nev > 0) {
+      bool ok = factor_at(sigma);
+      for (int a = 0; !ok && a < 3; ++a) ok = factor_at(sigma *= (1 + 1e-7));
+      if (!ok) return fail_factor(sigma, "L D L^T of K - sigma M broke down at this DOF");
+    }
+    selection = Spectra::SortRule::LargestMagn;
+  }
+  sum.shift = sigma;
+  sum.num_rigid = static_cast<int>(r);
+
+  // Rigid-body modes (from the basis).
+  std::vector<double> lam;
+  std::vector<Eigen::VectorXd> vec;
+  std::vector<char> rigid;
+  const int rigid_take = band ? (opt.band_lo <= 0 ? static_cast<int>(r) : 0)
+                              : std::min<int>(static_cast<int>(r), opt.num_modes);
+  for (int j = 0; j < rigid_take; ++j) {
+    Eigen::VectorXd kp(n);
+    symmetric_multiply(Ku, Phi.col(j).data(), kp.data());
+    lam.push_back(Phi.col(j).dot(kp));
+    vec.push_back(Phi.col(j));
+    rigid.push_back(1);
+  }
+
+  bool converged = true;
+  if (nev > 0) {
+    auto tl = Clock::now();
+    const int n_eff = static_cast<int>(n - r);
+    int extra = band ? 2 : 0;
+    for (int attempt = 0; attempt < 3; ++attempt) {
+      const int want = std::min(nev + extra, n_eff - 1);
+      int ncv = opt.subspace > 0 ? opt.subspace : std::max(2 * want + 1, want + 20);
+      ncv = std::min(ncv, n_eff);
+      if (want < 1 || ncv <= want) {
+        sum.status = EigenStatus::kInvalidInput;
+        sum.message = "too many modes requested for the sparse solver; use the dense path";
+        return sol;
+      }
+      ShiftInvertOperator op(F, sigma, Phi, MPhi);
+      MassOperator Bop(Mu);
+      using Solver = Spectra::SymGEigsShiftSolver<ShiftInvertOperator, MassOperator, Spectra::GEigsMode::ShiftInvert>;
+      Solver eigs(op, Bop, want, ncv, sigma);
+      // Start vector in the range of the operator (purified of null(M) and rigid directions); fixed seed.
+      std::mt19937_64 rng(20241121);
+      std::uniform_real_distribution<double> u(-1.0, 1.0);
+      Eigen::VectorXd x0(n), b0(n), v0(n);
+      for (Eigen::Index i = 0; i < n; ++i) x0[i] = u(rng);
+      symmetric_multiply(Mu, x0.data(), b0.data());
+      op.perform_op(b0.data(), v0.data());
+      eigs.init(v0.data());
+      report(opt, "lanczos", -1);
+      eigs.compute(selection, opt.max_restarts, opt.tolerance, Spectra::SortRule::SmallestAlge);
+      sum.solves += op.count();
+      sum.restarts += static_cast<int>(eigs.num_iterations());
+      const Eigen::VectorXd ev = eigs.eigenvalues();
+      const Eigen::MatrixXd V = eigs.eigenvectors();
+      if (eigs.info() != Spectra::CompInfo::Successful && ev.size() < want) {
+        converged = false;
+        sum.message = "Lanczos converged " + std::to_string(ev.size()) + " of " + std::to_string(want) +
+                      " modes in " + std::to_string(opt.max_restarts) +
+                      " restarts; raise max_restarts or the subspace size, or move the shift";
+      }
+      std::vector<int> keep;
+      for (Eigen::Index k = 0; k < ev.size(); ++k)
+        if (!band || in_band(ev[k], opt)) keep.push_back(static_cast<int>(k));
+      if (band && static_cast<int>(keep.size()) < nev && converged) {
+        extra += nev;  // the nearest eigenvalues to sigma were not all in the band: widen and retry
+        continue;
+      }
+      for (int k : keep) {
+        if (!band && static_cast<int>(lam.size()) >= opt.num_modes) break;
+        lam.push_back(ev[k]);
+        vec.push_back(V.col(k));
+        rigid.push_back(0);
+      }
+      break;
+    }
+    sum.time_lanczos = seconds_since(tl);
+  }
+
+  const Eigen::Index m = static_cast<Eigen::Index>(lam.size());
+  sol.eigenvalues = Eigen::Map<Eigen::VectorXd>(lam.data(), m);
+  sol.modes.resize(n, m);
+  for (Eigen::Index k = 0; k < m; ++k) sol.modes.col(k) = vec[k];
+  sol.rigid_body = rigid;
+
+  // Without a rigid basis, zero-energy modes of a singular K are recognised by their residual ||K phi||.
+  const double nK = norm1(Ku), nM = norm1(Mu);
+  if (r == 0 && sigma < 0 && opt.allow_singular_stiffness) {
+    for (Eigen::Index k = 0; k < m; ++k) {
+      Eigen::VectorXd kp(n);
+      symmetric_multiply(Ku, sol.modes.col(k).data(), kp.data());
+      if (kp.norm() <= opt.rigid_residual_tolerance * nK * sol.modes.col(k).norm()) sol.rigid_body[k] = 1;
+    }
+    sum.num_rigid = static_cast<int>(std::count(sol.rigid_body.begin(), sol.rigid_body.end(), 1));
+  }
+  finish(&sol);
+  sol.residuals.resize(m);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    Eigen::VectorXd kp(n), mp(n);
+    symmetric_multiply(Ku, sol.modes.col(k).data(), kp.data());
+    symmetric_multiply(Mu, sol.modes.col(k).data(), mp.data());
+    const double lamk = sol.eigenvalues[k];
+    sol.residuals[k] = (kp - lamk * mp).norm() / ((nK + std::abs(lamk) * nM) * sol.modes.col(k).norm());
+  }
+  sum.max_residual = m > 0 ? sol.residuals.maxCoeff() : 0.0;
+  if (band && m != band_count && converged) {
+    converged = false;
+    sum.message = "found " + std::to_string(m) + " modes in the band, the inertia count says " +
+                  std::to_string(band_count);
+  }
+  sum.status = converged ? EigenStatus::kSuccess : EigenStatus::kNotConverged;
+  report(opt, "done", 1.0);
+  return sol;
+}
+
+EigenSolution solve_eigen_dense(const Eigen::MatrixXd& K, const Eigen::MatrixXd& M, const EigenOptions& opt) {
+  check_inputs(K.rows(), K.cols(), M.rows(), M.cols(), opt);
+  if (!K.allFinite()) throw InputError("eigen-solve: K holds a NaN or Inf entry");
+  if (!M.allFinite()) throw InputError("eigen-solve: M holds a NaN or Inf entry");
+  const Eigen::Index n = K.rows();
+  EigenSolution sol;
+  EigenSummary& sum = sol.summary;
+  sum.method = "dense";
+  auto t0 = Clock::now();
+  const Eigen::MatrixXd Ks = 0.5 * (K + K.transpose()), Ms = 0.5 * (M + M.transpose());
+  Eigen::VectorXd lam;
+  Eigen::MatrixXd V;
+  const Eigen::LLT<Eigen::MatrixXd> lltM(Ms);
+  const Eigen::VectorXd Ld = lltM.info() == Eigen::Success ? Eigen::VectorXd(lltM.matrixLLT().diagonal())
+                                                            : Eigen::VectorXd();
+  const bool m_pd = lltM.info() == Eigen::Success && Ld.minCoeff() > 1e-7 * Ld.maxCoeff();
+  if (m_pd) {
+    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(Ks, Ms);
+    if (es.info() != Eigen::Success) {
+      sum.status = EigenStatus::kNotConverged;
+      sum.message = "dense generalized eigen-solver did not converge";
+      return sol;
+    }
+    lam = es.eigenvalues();
+    V = es.eigenvectors();
+  } else {
+    // Singular (or nearly singular) M: with A = K - sigma M = L L^T positive definite (sigma < 0), the pencil
+    // becomes the standard problem C y = theta y, C = L^{-1} M L^{-T}, theta = 1 / (lambda - sigma);
+    // theta = 0 are the infinite eigenvalues of the massless directions and are dropped.
+    const double sigma = -std::sqrt(std::numeric_limits<double>::epsilon()) *
+                         max_stiffness_to_mass(Ks.diagonal(), Ms.diagonal());
+    sum.shift = sigma;
+    const Eigen::LLT<Eigen::MatrixXd> llt(Ks - sigma * Ms);
+    if (llt.info() != Eigen::Success) {
+      sum.status = EigenStatus::kFactorizationFailed;
+      sum.message = "K - sigma M is not positive definite: a mechanism with no mass";
+      return sol;
+    }
+    const Eigen::MatrixXd Li = llt.matrixL().solve(Eigen::MatrixXd::Identity(n, n));
+    const Eigen::MatrixXd C = Li * Ms * Li.transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (C + C.transpose()));
+    const Eigen::VectorXd th = es.eigenvalues();
+    const double tmax = th.cwiseAbs().maxCoeff();
+    std::vector<Eigen::Index> idx;
+    for (Eigen::Index i = n - 1; i >= 0; --i)
+      if (th[i] > 1e3 * std::numeric_limits<double>::epsilon() * tmax) idx.push_back(i);
+    lam.resize(static_cast<Eigen::Index>(idx.size()));
+    V.resize(n, static_cast<Eigen::Index>(idx.size()));
+    for (std::size_t k = 0; k < idx.size(); ++k) {
+      const Eigen::Index i = idx[k];
+      lam[static_cast<Eigen::Index>(k)] = sigma + 1.0 / th[i];
+      V.col(static_cast<Eigen::Index>(k)) = llt.matrixU().solve(es.eigenvectors().col(i)) / std::sqrt(th[i]);
+    }
+  }
+  // Rigid-body modes: as many as the supplied basis has (they are the lowest), else by residual ||K phi||.
+  const Eigen::Index r = opt.rigid_body_basis.cols();
+  const double nK = Ks.cwiseAbs().colwise().sum().maxCoeff(), nM = Ms.cwiseAbs().colwise().sum().maxCoeff();
+  std::vector<char> rigid(static_cast<std::size_t>(lam.size()), 0);
+  for (Eigen::Index k = 0; k < lam.size(); ++k) {
+    if (r > 0)
+      rigid[k] = k < r;
+    else
+      rigid[k] = (Ks * V.col(k)).norm() <= opt.rigid_residual_tolerance * nK * V.col(k).norm();
+  }
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index k = 0; k < lam.size(); ++k) {
+    if (band_mode(opt) ? (rigid[k] ? opt.band_lo <= 0 : in_band(lam[k], opt))
+                       : static_cast<int>(keep.size()) < opt.num_modes)
+      keep.push_back(k);
+  }
+  const Eigen::Index m = static_cast<Eigen::Index>(keep.size());
+  sol.eigenvalues.resize(m);
+  sol.modes.resize(n, m);
+  sol.rigid_body.resize(m);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    sol.eigenvalues[k] = lam[keep[k]];
+    sol.modes.col(k) = V.col(keep[k]);
+    sol.rigid_body[k] = rigid[keep[k]];
+  }
+  sum.num_rigid = static_cast<int>(std::count(sol.rigid_body.begin(), sol.rigid_body.end(), 1));
+  finish(&sol);
+  sol.residuals.resize(m);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    const double l = sol.eigenvalues[k];
+    sol.residuals[k] = (Ks * sol.modes.col(k) - l * (Ms * sol.modes.col(k))).norm() /
+                       ((nK + std::abs(l) * nM) * sol.modes.col(k).norm());
+  }
+  sum.max_residual = m > 0 ? sol.residuals.maxCoeff() : 0.0;
+  sum.time_lanczos = seconds_since(t0);
+  sum.status = EigenStatus::kSuccess;
+  if (!band_mode(opt) && m < opt.num_modes) sum.message = "the model has only " + std::to_string(m) + " finite modes";
+  return sol;
+}
+
+}  // namespace dynid

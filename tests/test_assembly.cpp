@@ -1,0 +1,99 @@
+// Sparse assembly: equal to a straightforward dense assembly, symmetric, and bitwise identical for any number
+// of threads.
+#include <omp.h>
+
+#include <cstring>
+
+#include "dynid/engine/modal.hpp"
+#include "dynid/mesh/error.hpp"
+#include "dynid/mesh/generators.hpp"
+#include "test_util.hpp"
+
+namespace dynid {
+namespace {
+
+Frame3DSpec Small3D() {
+  Frame3DSpec s;
+  s.bays_x = 3;
+  s.bays_y = 2;
+  s.stories = 4;
+  s.divisions = 2;
+  s.material = {"steel", 2.1e11, 0, 0.3, 7800};
+  s.column = {"col", 4e-3, 8e-6, 1.2e-5, 0};
+  s.beam = {"beam", 3e-3, 5e-6, 9e-6, 0};
+  return s;
+}
+
+// Reference: every element matrix added entry by entry into a dense matrix.
+void DenseAssembly(const ElementSource& src, Eigen::MatrixXd* K, Eigen::MatrixXd* M) {
+  K->setZero(src.num_dofs(), src.num_dofs());
+  M->setZero(src.num_dofs(), src.num_dofs());
+  std::vector<int> d;
+  Eigen::MatrixXd Ke, Me;
+  for (int e = 0; e < src.num_elements(); ++e) {
+    src.element_dofs(e, &d);
+    src.element_matrices(e, &Ke, &Me);
+    for (std::size_t a = 0; a < d.size(); ++a)
+      for (std::size_t b = 0; b < d.size(); ++b)
+        if (d[a] >= 0 && d[b] >= 0) {
+          (*K)(d[a], d[b]) += Ke(a, b);
+          (*M)(d[a], d[b]) += Me(a, b);
+        }
+  }
+}
+
+TEST(Assembly, MatchesDenseAssembly) {
+  const Model m = make_frame3d(Small3D());
+  const AssembledSystem s = assemble_system(m);
+  Eigen::MatrixXd K, M;
+  DenseAssembly(m, &K, &M);
+  // Same sums in a different order: agreement to a few ulps of the largest entry.
+  EXPECT_LT((test::Dense(s.K) - K).cwiseAbs().maxCoeff(), 1e-14 * K.cwiseAbs().maxCoeff());
+  EXPECT_LT((test::Dense(s.M) - M).cwiseAbs().maxCoeff(), 1e-14 * M.cwiseAbs().maxCoeff());
+  EXPECT_EQ(test::Dense(s.K), test::Dense(s.K).transpose());  // bitwise symmetric
+}
+
+TEST(Assembly, BitwiseIdenticalForOneAndTwoThreads) {
+  const Model m = make_frame3d(Small3D());
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const AssembledSystem a = assemble_system(m);
+  omp_set_num_threads(2);
+  const AssembledSystem b = assemble_system(m);
+  omp_set_num_threads(saved);
+  ASSERT_EQ(a.K.nonZeros(), b.K.nonZeros());
+  EXPECT_EQ(0, std::memcmp(a.K.valuePtr(), b.K.valuePtr(), sizeof(double) * a.K.nonZeros()));
+  EXPECT_EQ(0, std::memcmp(a.M.valuePtr(), b.M.valuePtr(), sizeof(double) * a.M.nonZeros()));
+  EXPECT_EQ(0, std::memcmp(a.K.innerIndexPtr(), b.K.innerIndexPtr(), sizeof(int) * a.K.nonZeros()));
+}
+
+TEST(Assembly, ColoursSeparateElementsSharingDofs) {
+  const Model m = make_frame3d(Small3D());
+  const Assembler a(m);
+  // A frame joint joins up to 6 members: at least 2 colours, and few enough to keep threads busy.
+  EXPECT_GE(a.num_colors(), 2);
+  EXPECT_LE(a.num_colors(), 12);
+  EXPECT_EQ(a.num_dofs(), m.num_dofs());
+  EXPECT_EQ(frame3d_dofs(Small3D()), m.num_dofs());
+}
+
+TEST(Assembly, RejectsNonFiniteElementMatrices) {
+  struct Bad : ElementSource {
+    int num_dofs() const override { return 2; }
+    int num_elements() const override { return 1; }
+    void element_dofs(int, std::vector<int>* d) const override { *d = {0, 1}; }
+    void element_matrices(int, Eigen::MatrixXd* K, Eigen::MatrixXd* M) const override {
+      if (K) *K = Eigen::Matrix2d::Identity() * std::nan("");
+      if (M) *M = Eigen::Matrix2d::Identity();
+    }
+  } bad;
+  try {
+    assemble_system(bad);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("non-finite"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace dynid

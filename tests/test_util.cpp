@@ -1,0 +1,19 @@
+#include "test_util.hpp"
+
+#include <Eigen/Dense>
+
+namespace dynid::test {
+
+double SubspaceGap(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
+  const Eigen::MatrixXd Qa = Eigen::HouseholderQR<Eigen::MatrixXd>(A).householderQ() *
+                             Eigen::MatrixXd::Identity(A.rows(), A.cols());
+  const Eigen::MatrixXd Qb = Eigen::HouseholderQR<Eigen::MatrixXd>(B).householderQ() *
+                             Eigen::MatrixXd::Identity(B.rows(), B.cols());
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Qa.transpose() * Qb);
+  return 1.0 - svd.singularValues().minCoeff();
+}
+
+std::string CasesDir() { return DYNID_CASES_DIR; }
+std::string SharedDir() { return DYNID_SHARED_DIR; }
+
+}  // namespace dynid::test

@@ -1,0 +1,40 @@
+// Numeric test helpers: relative comparisons, MAC, eigen-residuals, case paths.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <cmath>
+#include <string>
+
+#include "dynid/mesh/error.hpp"
+#include "dynid/solvers/sparse.hpp"
+
+namespace dynid::test {
+
+/// |a - b| <= rtol * max(|a|, |b|) (or both exactly zero).
+inline ::testing::AssertionResult RelClose(double a, double b, double rtol) {
+  const double scale = std::max(std::abs(a), std::abs(b));
+  if (std::abs(a - b) <= rtol * scale) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << a << " vs " << b << ": relative difference "
+                                       << std::abs(a - b) / scale << " > " << rtol;
+}
+
+/// Modal assurance criterion of two real vectors: (a.b)^2 / (a.a b.b); 1 = same shape up to scale and sign.
+inline double Mac(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  const double ab = a.dot(b);
+  return ab * ab / (a.squaredNorm() * b.squaredNorm());
+}
+
+/// Largest angle-based distance between two subspaces given as column blocks (1 - min singular value of the
+/// product of their orthonormal bases): 0 when the spaces coincide.
+double SubspaceGap(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B);
+
+/// Folder of the repository's bundled cases and of ../shared (set by CMake).
+std::string CasesDir();
+std::string SharedDir();
+
+/// Dense copy of a sparse matrix.
+inline Eigen::MatrixXd Dense(const SparseMatrix& A) { return Eigen::MatrixXd(A); }
+
+}  // namespace dynid::test
