@@ -9,6 +9,7 @@
 
 #include "commands.hpp"
 #include "dynid/mesh/error.hpp"
+#include "dynid/solvers/blas.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -30,6 +31,7 @@ void set_threads(int n) {
 
 int main(int argc, char** argv) {
   using namespace dynid::cli;
+  dynid::ensure_blas_kernels(argv);
   CLI::App app{"dynid: finds where a structure differs from its finite-element model, and why, from vibration "
                "measurements.\nExit codes: 0 success, 1 numerical failure, 2 bad input or usage, 3 internal error."};
   app.require_subcommand(1);

@@ -94,20 +94,45 @@ bool CholmodFactor::factorize(const SparseMatrix& A) {
   return true;
 }
 
-void CholmodFactor::solve(const double* b, double* x) const {
-  cholmod_common& c = const_cast<cholmod_common&>(impl_->c);
+void CholmodFactor::solve_sys(int sys, const double* b, double* x, int ncol) const {
+  if (!impl_->L) throw InternalError("CholmodFactor: solve before analyze/factorize");
+  cholmod_common& c = impl_->c;
   cholmod_dense B;
   std::memset(&B, 0, sizeof(B));
   B.nrow = static_cast<size_t>(n_);
-  B.ncol = 1;
-  B.nzmax = static_cast<size_t>(n_);
+  B.ncol = static_cast<size_t>(ncol);
+  B.nzmax = static_cast<size_t>(n_) * static_cast<size_t>(ncol);
   B.d = static_cast<size_t>(n_);
   B.x = const_cast<double*>(b);
   B.xtype = CHOLMOD_REAL;
   B.dtype = CHOLMOD_DOUBLE;
-  if (!cholmod_solve2(CHOLMOD_A, impl_->L, &B, nullptr, &impl_->X, nullptr, &impl_->Y, &impl_->E, &c))
+  if (!cholmod_solve2(sys, impl_->L, &B, nullptr, &impl_->X, nullptr, &impl_->Y, &impl_->E, &c))
     throw NumericalError("CHOLMOD solve failed (status " + std::to_string(c.status) + ")");
-  std::memcpy(x, impl_->X->x, sizeof(double) * static_cast<size_t>(n_));
+  std::memcpy(x, impl_->X->x, sizeof(double) * static_cast<size_t>(n_) * static_cast<size_t>(ncol));
+}
+
+void CholmodFactor::solve(const double* b, double* x) const { solve_sys(CHOLMOD_A, b, x); }
+
+void CholmodFactor::forward(const double* b, double* x) const {
+  if (kind_ != Kind::kSupernodalLLt) throw InternalError("CholmodFactor::forward needs an LL^T factor");
+  solve_sys(CHOLMOD_P, b, x);
+  solve_sys(CHOLMOD_L, x, x);
+}
+
+void CholmodFactor::backward(const double* b, double* x) const {
+  if (kind_ != Kind::kSupernodalLLt) throw InternalError("CholmodFactor::backward needs an LL^T factor");
+  solve_sys(CHOLMOD_Lt, b, x);
+  solve_sys(CHOLMOD_Pt, x, x);
+}
+
+void CholmodFactor::backward_block(const Eigen::MatrixXd& B, Eigen::MatrixXd* X) const {
+  if (kind_ != Kind::kSupernodalLLt) throw InternalError("CholmodFactor::backward_block needs an LL^T factor");
+  if (B.rows() != n_) throw InternalError("CholmodFactor::backward_block: wrong number of rows");
+  X->resize(n_, B.cols());
+  if (B.cols() == 0) return;
+  const int k = static_cast<int>(B.cols());
+  solve_sys(CHOLMOD_Lt, B.data(), X->data(), k);
+  solve_sys(CHOLMOD_Pt, X->data(), X->data(), k);
 }
 
 int CholmodFactor::negative_pivots() const {

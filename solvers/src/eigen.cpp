@@ -1,6 +1,7 @@
 #include "dynid/solvers/eigen.hpp"
 
 #include <Eigen/Dense>
+#include <Spectra/SymEigsSolver.h>
 #include <Spectra/SymGEigsShiftSolver.h>
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 
 #include "dynid/mesh/error.hpp"
 #include "dynid/solvers/cholmod.hpp"
+#include "internal/blas_threads.hpp"
 
 namespace dynid {
 
@@ -57,6 +59,20 @@ class ShiftInvertOperator {
   mutable int count_ = 0;
 };
 
+// Sequential y = A x: inside the Lanczos loop the BLAS threads of the triangular solves are active, and OpenMP
+// threads here would compete with them for the two cores.
+void symmetric_multiply_seq(const SparseMatrix& A, const double* x, double* y) {
+  const int n = static_cast<int>(A.cols());
+  const int* cp = A.outerIndexPtr();
+  const int* ri = A.innerIndexPtr();
+  const double* v = A.valuePtr();
+  for (int i = 0; i < n; ++i) {
+    double s = 0.0;
+    for (int k = cp[i]; k < cp[i + 1]; ++k) s += v[k] * x[ri[k]];
+    y[i] = s;
+  }
+}
+
 // y = M x with M stored in full; Spectra's B operator.
 class MassOperator {
  public:
@@ -68,6 +84,40 @@ class MassOperator {
 
  private:
   const SparseMatrix& M_;
+};
+
+// The shift-invert operator in standard form on the Cholesky factor P (K - sigma M) P^T = L L^T:
+//   C = L^{-1} P M P^T L^{-T},  C y = theta y  <=>  K phi = lambda M phi,  theta = 1 / (lambda - sigma),
+//   phi = P^T L^{-T} y / sqrt(theta).
+// One solve and one M product per Lanczos step, and Euclidean orthogonalisation (the generalized form needs an
+// M product for every inner product). With a deflation basis Y (orthonormal eigenvectors of C, the rigid-body
+// modes) the result is projected: y <- y - Y Y^T y.
+class TransformedOperator {
+ public:
+  using Scalar = double;
+  TransformedOperator(const CholmodFactor& f, const SparseMatrix& M, const Eigen::MatrixXd& Y)
+      : f_(f), M_(M), Y_(Y), t_(f.rows()), u_(f.rows()) {}
+  Eigen::Index rows() const { return f_.rows(); }
+  Eigen::Index cols() const { return f_.rows(); }
+  void perform_op(const double* x, double* y) const {
+    f_.backward(x, t_.data());
+    symmetric_multiply_seq(M_, t_.data(), u_.data());
+    f_.forward(u_.data(), y);
+    ++count_;
+    if (Y_.cols() > 0) {
+      Eigen::Map<Eigen::VectorXd> yv(y, f_.rows());
+      const Eigen::VectorXd c = Y_.transpose() * yv;
+      yv.noalias() -= Y_ * c;
+    }
+  }
+  int count() const { return count_; }
+
+ private:
+  const CholmodFactor& f_;
+  const SparseMatrix& M_;
+  const Eigen::MatrixXd& Y_;
+  mutable Eigen::VectorXd t_, u_;
+  mutable int count_ = 0;
 };
 
 // Makes the entry of largest magnitude of each column positive (ties: the first one).
@@ -97,7 +147,8 @@ double max_stiffness_to_mass(const Eigen::VectorXd& kd, const Eigen::VectorXd& m
   return r > 0 ? r : 1.0;
 }
 
-// Sorts modes by eigenvalue and applies the sign convention.
+// Sorts modes (rigid-body first, then by eigenvalue) and applies the sign convention; the mode block is permuted
+// in place, one column at a time.
 void finish(EigenSolution* s) {
   const Eigen::Index m = s->eigenvalues.size();
   std::vector<Eigen::Index> order(m);
@@ -106,19 +157,30 @@ void finish(EigenSolution* s) {
     if (s->rigid_body[a] != s->rigid_body[b]) return s->rigid_body[a] > s->rigid_body[b];
     return s->eigenvalues[a] < s->eigenvalues[b];
   });
-  EigenSolution o;
-  o.eigenvalues.resize(m);
-  o.modes.resize(s->modes.rows(), m);
-  o.rigid_body.resize(m);
+  Eigen::VectorXd lam(m);
+  std::vector<char> rig(static_cast<std::size_t>(m));
   for (Eigen::Index k = 0; k < m; ++k) {
-    o.eigenvalues[k] = s->eigenvalues[order[k]];
-    o.modes.col(k) = s->modes.col(order[k]);
-    o.rigid_body[k] = s->rigid_body[order[k]];
+    lam[k] = s->eigenvalues[order[k]];
+    rig[k] = s->rigid_body[order[k]];
   }
-  normalize_signs(&o.modes);
-  s->eigenvalues = std::move(o.eigenvalues);
-  s->modes = std::move(o.modes);
-  s->rigid_body = std::move(o.rigid_body);
+  // Position k receives column order[k]: follow the cycles of the permutation with one spare column.
+  std::vector<char> done(static_cast<std::size_t>(m), 0);
+  Eigen::VectorXd tmp;
+  for (Eigen::Index start = 0; start < m; ++start) {
+    if (done[start] || order[start] == start) continue;
+    tmp = s->modes.col(start);
+    Eigen::Index k = start;
+    while (order[k] != start) {
+      s->modes.col(k) = s->modes.col(order[k]);
+      done[k] = 1;
+      k = order[k];
+    }
+    s->modes.col(k) = tmp;
+    done[k] = 1;
+  }
+  normalize_signs(&s->modes);
+  s->eigenvalues = lam;
+  s->rigid_body = rig;
 }
 
 void check_inputs(Eigen::Index kr, Eigen::Index kc, Eigen::Index mr, Eigen::Index mc, const EigenOptions& o) {
@@ -205,21 +267,24 @@ EigenSolution solve_eigen(const SparseMatrix& K, const SparseMatrix& M, const Ei
                            (n <= 300 || (!band && 2 * static_cast<Eigen::Index>(opt.num_modes) + 20 > n)));
   if (want_dense) return solve_eigen_dense(Eigen::MatrixXd(K), Eigen::MatrixXd(M), opt);
 
-  // Both matrices must share one pattern, so that K - sigma M is a sum of value arrays.
-  SparseMatrix Ku = K, Mu = M;
-  if (K.nonZeros() != M.nonZeros() ||
-      !std::equal(K.innerIndexPtr(), K.innerIndexPtr() + K.nonZeros(), M.innerIndexPtr()) ||
-      !std::equal(K.outerIndexPtr(), K.outerIndexPtr() + n + 1, M.outerIndexPtr())) {
-    const SparseMatrix P = (K.cwiseAbs() + M.cwiseAbs());  // union pattern
-    Ku = P * 0.0 + K;
-    Mu = P * 0.0 + M;
-    Ku.makeCompressed();
-    Mu.makeCompressed();
+  // Both matrices must share one pattern, so that K - sigma M is a sum of value arrays. Matrices assembled by
+  // dynid already do; others are brought to their union pattern (copies only then).
+  const bool same_pattern = K.nonZeros() == M.nonZeros() &&
+                            std::equal(K.outerIndexPtr(), K.outerIndexPtr() + n + 1, M.outerIndexPtr()) &&
+                            std::equal(K.innerIndexPtr(), K.innerIndexPtr() + K.nonZeros(), M.innerIndexPtr());
+  SparseMatrix Kcopy, Mcopy;
+  if (!same_pattern) {
+    const SparseMatrix P = K.cwiseAbs() + M.cwiseAbs();  // union pattern
+    Kcopy = P * 0.0 + K;
+    Mcopy = P * 0.0 + M;
+    Kcopy.makeCompressed();
+    Mcopy.makeCompressed();
   }
+  const SparseMatrix& Ku = same_pattern ? K : Kcopy;
+  const SparseMatrix& Mu = same_pattern ? M : Mcopy;
 
   EigenSolution sol;
   EigenSummary& sum = sol.summary;
-  sum.method = "sparse shift-invert Lanczos";
   auto t0 = Clock::now();
 
   // Rigid-body modes from the supplied null-space basis: exact, M-orthonormal, deflated from the Lanczos run.
@@ -235,11 +300,14 @@ EigenSolution solve_eigen(const SparseMatrix& K, const SparseMatrix& M, const Ei
 
   const Eigen::VectorXd kd = Ku.diagonal(), md = Mu.diagonal();
   const double s0 = std::sqrt(std::numeric_limits<double>::epsilon()) * max_stiffness_to_mass(kd, md);
-  SparseMatrix A = Ku;
-  auto form = [&](double sigma) {
+  SparseMatrix A;  // K - sigma M, formed only for sigma != 0
+  auto form = [&](double sigma) -> const SparseMatrix& {
+    if (sigma == 0.0) return Ku;
+    if (A.nonZeros() != Ku.nonZeros()) A = Ku;
     Eigen::Map<Eigen::VectorXd>(A.valuePtr(), A.nonZeros()) =
         Eigen::Map<const Eigen::VectorXd>(Ku.valuePtr(), Ku.nonZeros()) -
         sigma * Eigen::Map<const Eigen::VectorXd>(Mu.valuePtr(), Mu.nonZeros());
+    return A;
   };
 
   CholmodFactor F(band ? CholmodFactor::Kind::kSimplicialLDLt : CholmodFactor::Kind::kSupernodalLLt);
@@ -249,9 +317,9 @@ EigenSolution solve_eigen(const SparseMatrix& K, const SparseMatrix& M, const Ei
 
   auto factor_at = [&](double sigma) {
     auto tf = Clock::now();
-    form(sigma);
+    const SparseMatrix& shifted = form(sigma);
     report(opt, "factorize", -1);
-    const bool ok = F.factorize(A);
+    const bool ok = F.factorize(shifted);
     sum.time_factorize += seconds_since(tf);
     sum.factor_nonzeros = F.factor_nonzeros();
     sum.factor_flops = F.factor_flops();
@@ -325,18 +393,31 @@ EigenSolution solve_eigen(const SparseMatrix& K, const SparseMatrix& M, const Ei
 
   // Rigid-body modes (from the basis).
   std::vector<double> lam;
-  std::vector<Eigen::VectorXd> vec;
   std::vector<char> rigid;
+  Eigen::MatrixXd elastic;       // Lanczos eigenvectors (n x found)
+  std::vector<int> elastic_keep;  // which of their columns are returned
   const int rigid_take = band ? (opt.band_lo <= 0 ? static_cast<int>(r) : 0)
                               : std::min<int>(static_cast<int>(r), opt.num_modes);
   for (int j = 0; j < rigid_take; ++j) {
     Eigen::VectorXd kp(n);
     symmetric_multiply(Ku, Phi.col(j).data(), kp.data());
     lam.push_back(Phi.col(j).dot(kp));
-    vec.push_back(Phi.col(j));
     rigid.push_back(1);
   }
 
+  // The standard (Cholesky-transformed) form needs an LL^T factor: the lowest-modes mode. Band mode works on an
+  // indefinite L D L^T factor and uses the generalized form.
+  const bool standard = !band && opt.formulation == EigenOptions::Formulation::kCholeskyStandard;
+  sum.method = standard ? "sparse shift-invert Lanczos (Cholesky standard form)"
+                        : "sparse shift-invert Lanczos (generalized, M inner product)";
+  Eigen::MatrixXd Yr(n, 0);
+  if (standard && r > 0 && nev > 0) {
+    // Rigid modes in the transformed space: y = L^T P phi = -sigma L^{-1} P M phi (from (K - sigma M) phi =
+    // -sigma M phi), orthonormalised.
+    Yr.resize(n, r);
+    for (Eigen::Index j = 0; j < r; ++j) F.forward(MPhi.col(j).data(), Yr.col(j).data());
+    Yr = Eigen::HouseholderQR<Eigen::MatrixXd>(Yr).householderQ() * Eigen::MatrixXd::Identity(n, r);
+  }
   bool converged = true;
   if (nev > 0) {
     auto tl = Clock::now();
@@ -351,25 +432,49 @@ EigenSolution solve_eigen(const SparseMatrix& K, const SparseMatrix& M, const Ei
         sum.message = "too many modes requested for the sparse solver; use the dense path";
         return sol;
       }
-      ShiftInvertOperator op(F, sigma, Phi, MPhi);
-      MassOperator Bop(Mu);
-      using Solver = Spectra::SymGEigsShiftSolver<ShiftInvertOperator, MassOperator, Spectra::GEigsMode::ShiftInvert>;
-      Solver eigs(op, Bop, want, ncv, sigma);
-      // Start vector in the range of the operator (purified of null(M) and rigid directions); fixed seed.
+      // Start vector: random with a fixed seed, then mapped through the operator so that it lies in its range
+      // (purified of massless and rigid-body directions).
       std::mt19937_64 rng(20241121);
       std::uniform_real_distribution<double> u(-1.0, 1.0);
       Eigen::VectorXd x0(n), b0(n), v0(n);
       for (Eigen::Index i = 0; i < n; ++i) x0[i] = u(rng);
-      symmetric_multiply(Mu, x0.data(), b0.data());
-      op.perform_op(b0.data(), v0.data());
-      eigs.init(v0.data());
+      Eigen::VectorXd ev;
+      Eigen::MatrixXd V;
+      bool ok = false;
       report(opt, "lanczos", -1);
-      eigs.compute(selection, opt.max_restarts, opt.tolerance, Spectra::SortRule::SmallestAlge);
-      sum.solves += op.count();
-      sum.restarts += static_cast<int>(eigs.num_iterations());
-      const Eigen::VectorXd ev = eigs.eigenvalues();
-      const Eigen::MatrixXd V = eigs.eigenvectors();
-      if (eigs.info() != Spectra::CompInfo::Successful && ev.size() < want) {
+      if (standard) {
+        TransformedOperator op(F, Mu, Yr);
+        Spectra::SymEigsSolver<TransformedOperator> eigs(op, want, ncv);
+        op.perform_op(x0.data(), v0.data());
+        eigs.init(v0.data());
+        eigs.compute(Spectra::SortRule::LargestAlge, opt.max_restarts, opt.tolerance, Spectra::SortRule::LargestAlge);
+        sum.solves += op.count();
+        sum.restarts += static_cast<int>(eigs.num_iterations());
+        ok = eigs.info() == Spectra::CompInfo::Successful;
+        const Eigen::VectorXd th = eigs.eigenvalues();  // descending theta = ascending lambda
+        const Eigen::MatrixXd Y = eigs.eigenvectors();
+        ev.resize(th.size());
+        F.backward_block(Y, &V);
+        for (Eigen::Index k = 0; k < th.size(); ++k) {
+          ev[k] = sigma + 1.0 / th[k];
+          V.col(k) /= std::sqrt(th[k]);
+        }
+      } else {
+        ShiftInvertOperator op(F, sigma, Phi, MPhi);
+        MassOperator Bop(Mu);
+        using Solver = Spectra::SymGEigsShiftSolver<ShiftInvertOperator, MassOperator, Spectra::GEigsMode::ShiftInvert>;
+        Solver eigs(op, Bop, want, ncv, sigma);
+        symmetric_multiply(Mu, x0.data(), b0.data());
+        op.perform_op(b0.data(), v0.data());
+        eigs.init(v0.data());
+        eigs.compute(selection, opt.max_restarts, opt.tolerance, Spectra::SortRule::SmallestAlge);
+        sum.solves += op.count();
+        sum.restarts += static_cast<int>(eigs.num_iterations());
+        ok = eigs.info() == Spectra::CompInfo::Successful;
+        ev = eigs.eigenvalues();
+        V = eigs.eigenvectors();
+      }
+      if (!ok && ev.size() < want) {
         converged = false;
         sum.message = "Lanczos converged " + std::to_string(ev.size()) + " of " + std::to_string(want) +
                       " modes in " + std::to_string(opt.max_restarts) +
@@ -385,9 +490,10 @@ EigenSolution solve_eigen(const SparseMatrix& K, const SparseMatrix& M, const Ei
       for (int k : keep) {
         if (!band && static_cast<int>(lam.size()) >= opt.num_modes) break;
         lam.push_back(ev[k]);
-        vec.push_back(V.col(k));
+        elastic_keep.push_back(k);
         rigid.push_back(0);
       }
+      elastic = std::move(V);
       break;
     }
     sum.time_lanczos = seconds_since(tl);
@@ -395,8 +501,17 @@ EigenSolution solve_eigen(const SparseMatrix& K, const SparseMatrix& M, const Ei
 
   const Eigen::Index m = static_cast<Eigen::Index>(lam.size());
   sol.eigenvalues = Eigen::Map<Eigen::VectorXd>(lam.data(), m);
-  sol.modes.resize(n, m);
-  for (Eigen::Index k = 0; k < m; ++k) sol.modes.col(k) = vec[k];
+  const bool all_in_order = rigid_take == 0 && static_cast<Eigen::Index>(elastic_keep.size()) == elastic.cols() &&
+                            std::is_sorted(elastic_keep.begin(), elastic_keep.end());
+  if (all_in_order) {
+    sol.modes = std::move(elastic);  // the common case: no copy of the n x m block
+  } else {
+    sol.modes.resize(n, m);
+    sol.modes.leftCols(rigid_take) = Phi.leftCols(rigid_take);
+    for (std::size_t k = 0; k < elastic_keep.size(); ++k)
+      sol.modes.col(rigid_take + static_cast<Eigen::Index>(k)) = elastic.col(elastic_keep[k]);
+    elastic.resize(0, 0);
+  }
   sol.rigid_body = rigid;
 
   // Without a rigid basis, zero-energy modes of a singular K are recognised by their residual ||K phi||.

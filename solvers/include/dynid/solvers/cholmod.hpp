@@ -1,6 +1,7 @@
 // dynid/solvers/cholmod.hpp -- an owned CHOLMOD factorization of a symmetric sparse matrix.
 #pragma once
 
+#include <Eigen/Core>
 #include <memory>
 
 #include "dynid/solvers/sparse.hpp"
@@ -32,6 +33,12 @@ class CholmodFactor {
   bool factorize(const SparseMatrix& A);
   /// x = A^{-1} b (b and x may alias).
   void solve(const double* b, double* x) const;
+  /// LL^T only, with P A P^T = L L^T: forward(b) = L^{-1} P b and backward(b) = P^T L^{-T} b, so that
+  /// A^{-1} = backward o forward. Used to turn K phi = lambda M phi into a standard symmetric problem.
+  void forward(const double* b, double* x) const;
+  void backward(const double* b, double* x) const;
+  /// backward() for the k columns of B at once (blocked, BLAS-3): X = P^T L^{-T} B.
+  void backward_block(const Eigen::MatrixXd& B, Eigen::MatrixXd* X) const;
   /// Row/column of A (original numbering) at which the last factorize() broke down, or -1.
   int failed_index() const { return failed_; }
   /// LDL^T only: the number of negative entries of D, i.e. the number of negative eigenvalues of A.
@@ -42,6 +49,7 @@ class CholmodFactor {
   Kind kind() const { return kind_; }
 
  private:
+  void solve_sys(int sys, const double* b, double* x, int ncol = 1) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
   Kind kind_;

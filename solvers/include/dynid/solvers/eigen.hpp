@@ -43,6 +43,13 @@ struct EigenOptions {
   /// |theta - theta_exact| <= tolerance * |theta| (Spectra's criterion).
   int max_restarts = 500;
   double tolerance = 1e-10;
+  /// How the shift-invert Lanczos run is set up (lowest-modes mode; band mode always uses kGeneralized):
+  ///  kCholeskyStandard: Spectra SymEigsSolver on C = L^{-1} P M P^T L^{-T} (P (K - sigma M) P^T = L L^T), one
+  ///    solve and one M product per step, Euclidean orthogonalisation. Default: several times faster.
+  ///  kGeneralized: Spectra SymGEigsShiftSolver (shift-invert mode) with (K - sigma M)^{-1} M in the M inner
+  ///    product; every inner product costs an M product.
+  enum class Formulation { kCholeskyStandard, kGeneralized };
+  Formulation formulation = Formulation::kCholeskyStandard;
   enum class Method { kAuto, kSparse, kDense };
   /// kAuto: dense for n <= 300 (or when the wanted modes approach n), sparse otherwise.
   Method method = Method::kAuto;

@@ -1,0 +1,19 @@
+// dynid/io/matrix_market.hpp -- Matrix Market (coordinate, real) files: exchange of K and M with other codes.
+#pragma once
+
+#include <string>
+
+#include "dynid/solvers/sparse.hpp"
+
+namespace dynid {
+
+/// Writes A in Matrix Market coordinate format, "real symmetric" (lower triangle) or "real general".
+/// 17 significant digits, so that a read-back is bitwise identical. Written atomically; refuses to replace an
+/// existing file unless `overwrite`.
+void write_matrix_market(const std::string& path, const SparseMatrix& A, bool symmetric, bool overwrite);
+
+/// Reads a Matrix Market "coordinate real|integer general|symmetric" file into full (both-triangle) storage.
+/// Duplicate entries are summed. Errors name the file and line.
+SparseMatrix read_matrix_market(const std::string& path);
+
+}  // namespace dynid
