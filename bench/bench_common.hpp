@@ -6,6 +6,7 @@
 namespace dynid::bench {
 
 inline Material Steel() { return {"steel", 2.1e11, 0, 0.3, 7850}; }
+// Strong axis = local y (columns: local z along global X; beams: local y horizontal), see frame3d_axes.
 inline Section Column() { return {"HEB300", 1.49e-2, 2.52e-4, 8.56e-5, 1.85e-6}; }
 inline Section Beam() { return {"IPE400", 8.45e-3, 2.31e-4, 1.32e-5, 5.1e-7}; }
 

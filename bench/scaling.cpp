@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_common.hpp"
 #include "dynid/engine/modal.hpp"
 #include "dynid/io/matrix_market.hpp"
 #include "dynid/mesh/generators.hpp"
@@ -41,7 +42,6 @@ struct Spec {
 };
 
 dynid::Model Build(const Spec& s) {
-  const dynid::Material steel{"steel", 2.1e11, 0, 0.3, 7850};
   if (s.three_d) {
     dynid::Frame3DSpec f;
     f.bays_x = s.a;
@@ -50,9 +50,9 @@ dynid::Model Build(const Spec& s) {
     f.divisions = s.div;
     f.span_x = f.span_y = 6.0;
     f.height = 3.5;
-    f.material = steel;
-    f.column = {"HEB300", 1.49e-2, 8.56e-5, 2.52e-4, 1.85e-6};
-    f.beam = {"IPE400", 8.45e-3, 1.32e-5, 2.31e-4, 5.1e-7};
+    f.material = dynid::bench::Steel();
+    f.column = dynid::bench::Column();
+    f.beam = dynid::bench::Beam();
     return dynid::make_frame3d(f);
   }
   dynid::Frame2DSpec f;
@@ -61,9 +61,9 @@ dynid::Model Build(const Spec& s) {
   f.divisions = s.div;
   f.span = 6.0;
   f.height = 3.5;
-  f.material = steel;
-  f.column = {"HEB300", 1.49e-2, 8.56e-5, 2.52e-4, 1.85e-6};
-  f.beam = {"IPE400", 8.45e-3, 1.32e-5, 2.31e-4, 5.1e-7};
+  f.material = dynid::bench::Steel();
+  f.column = dynid::bench::Column();
+  f.beam = dynid::bench::Beam();
   return dynid::make_frame2d(f);
 }
 

@@ -174,6 +174,43 @@ void symmetric_multiply(const SparseMatrix& A, const double* x, double* y) {
   }
 }
 
+void residual_forces(const SparseMatrix& K, const SparseMatrix& M, const Eigen::MatrixXd& Phi,
+                     const Eigen::VectorXd& lambda, Eigen::MatrixXd* R) {
+  const int n = static_cast<int>(K.rows());
+  const Eigen::Index m = Phi.cols();
+  if (M.rows() != n || Phi.rows() != n || lambda.size() != m)
+    throw InputError("residual_forces: sizes of K, M, Phi and lambda do not match");
+  const bool same = K.nonZeros() == M.nonZeros() &&
+                    std::equal(K.outerIndexPtr(), K.outerIndexPtr() + n + 1, M.outerIndexPtr()) &&
+                    std::equal(K.innerIndexPtr(), K.innerIndexPtr() + K.nonZeros(), M.innerIndexPtr());
+  R->resize(n, m);
+  if (!same) {  // general patterns: two products
+    *R = -(K * Phi) + (M * Phi) * lambda.asDiagonal();
+    return;
+  }
+  const int* cp = K.outerIndexPtr();
+  const int* ri = K.innerIndexPtr();
+  const double* kv = K.valuePtr();
+  const double* mv = M.valuePtr();
+  // Row i of a symmetric matrix = column i: R(i, k) = sum_j (-K_ij + lambda_k M_ij) Phi(j, k). Row-major
+  // copies keep the k loop contiguous.
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const RowMajor P = Phi;
+  RowMajor out(n, m);
+  const double* lam = lambda.data();
+#pragma omp parallel for schedule(static)
+  for (int i = 0; i < n; ++i) {
+    double* acc = out.data() + static_cast<std::size_t>(i) * m;
+    for (Eigen::Index k = 0; k < m; ++k) acc[k] = 0.0;
+    for (int p = cp[i]; p < cp[i + 1]; ++p) {
+      const double* phi = P.data() + static_cast<std::size_t>(ri[p]) * m;
+      const double kk = kv[p], mm = mv[p];
+      for (Eigen::Index k = 0; k < m; ++k) acc[k] += (lam[k] * mm - kk) * phi[k];
+    }
+  }
+  *R = out;
+}
+
 double norm1(const SparseMatrix& A) {
   double m = 0.0;
   for (int j = 0; j < A.outerSize(); ++j) {

@@ -125,6 +125,12 @@ void CholmodFactor::backward(const double* b, double* x) const {
   solve_sys(CHOLMOD_Pt, x, x);
 }
 
+void CholmodFactor::solve_block(const Eigen::MatrixXd& B, Eigen::MatrixXd* X) const {
+  if (B.rows() != n_) throw InternalError("CholmodFactor::solve_block: wrong number of rows");
+  X->resize(n_, B.cols());
+  if (B.cols() > 0) solve_sys(CHOLMOD_A, B.data(), X->data(), static_cast<int>(B.cols()));
+}
+
 void CholmodFactor::backward_block(const Eigen::MatrixXd& B, Eigen::MatrixXd* X) const {
   if (kind_ != Kind::kSupernodalLLt) throw InternalError("CholmodFactor::backward_block needs an LL^T factor");
   if (B.rows() != n_) throw InternalError("CholmodFactor::backward_block: wrong number of rows");

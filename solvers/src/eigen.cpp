@@ -13,7 +13,6 @@
 
 #include "dynid/mesh/error.hpp"
 #include "dynid/solvers/cholmod.hpp"
-#include "internal/blas_threads.hpp"
 
 namespace dynid {
 
@@ -255,7 +254,42 @@ double eigen_residual(const SparseMatrix& K, const SparseMatrix& M, double lambd
   return den > 0 ? (kp - lambda * mp).norm() / den : 0.0;
 }
 
+// Factorizations kept between solves of matrices with one pattern: the symbolic analysis is reused.
+struct EigenSolver::Cache {
+  std::unique_ptr<CholmodFactor> factor[2];  // [0] LL^T, [1] LDL^T
+  bool llt_valid = false;                    // factor[0] holds K - sigma M of the last solve
+  std::vector<int> outer[2], inner[2];       // the pattern each was analysed for
+  CholmodFactor& get(CholmodFactor::Kind kind, const SparseMatrix& A, double* t_analyze) {
+    const int k = kind == CholmodFactor::Kind::kSupernodalLLt ? 0 : 1;
+    const int n = static_cast<int>(A.cols());
+    const bool same = factor[k] && static_cast<int>(outer[k].size()) == n + 1 &&
+                      static_cast<Eigen::Index>(inner[k].size()) == A.nonZeros() &&
+                      std::equal(outer[k].begin(), outer[k].end(), A.outerIndexPtr()) &&
+                      std::equal(inner[k].begin(), inner[k].end(), A.innerIndexPtr());
+    if (!same) {
+      const auto t0 = Clock::now();
+      factor[k] = std::make_unique<CholmodFactor>(kind);
+      factor[k]->analyze(A);
+      outer[k].assign(A.outerIndexPtr(), A.outerIndexPtr() + n + 1);
+      inner[k].assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
+      *t_analyze += seconds_since(t0);
+    }
+    return *factor[k];
+  }
+};
+
+EigenSolver::EigenSolver(const EigenOptions& options) : cache_(std::make_unique<Cache>()), options_(options) {}
+EigenSolver::~EigenSolver() = default;
+
+const CholmodFactor* EigenSolver::factor() const { return cache_->llt_valid ? cache_->factor[0].get() : nullptr; }
+
 EigenSolution solve_eigen(const SparseMatrix& K, const SparseMatrix& M, const EigenOptions& opt) {
+  return EigenSolver(opt).solve(K, M);
+}
+
+EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
+  const EigenOptions& opt = options_;
+  cache_->llt_valid = false;
   check_inputs(K.rows(), K.cols(), M.rows(), M.cols(), opt);
   check_finite(K.valuePtr(), K.nonZeros(), "K");
   check_finite(M.valuePtr(), M.nonZeros(), "M");
@@ -285,7 +319,6 @@ EigenSolution solve_eigen(const SparseMatrix& K, const SparseMatrix& M, const Ei
 
   EigenSolution sol;
   EigenSummary& sum = sol.summary;
-  auto t0 = Clock::now();
 
   // Rigid-body modes from the supplied null-space basis: exact, M-orthonormal, deflated from the Lanczos run.
   Eigen::MatrixXd Phi(n, 0), MPhi(n, 0);
@@ -310,10 +343,9 @@ EigenSolution solve_eigen(const SparseMatrix& K, const SparseMatrix& M, const Ei
     return A;
   };
 
-  CholmodFactor F(band ? CholmodFactor::Kind::kSimplicialLDLt : CholmodFactor::Kind::kSupernodalLLt);
   report(opt, "analyze", -1);
-  F.analyze(Ku);
-  sum.time_analyze = seconds_since(t0);
+  CholmodFactor& F = cache_->get(band ? CholmodFactor::Kind::kSimplicialLDLt : CholmodFactor::Kind::kSupernodalLLt,
+                                 Ku, &sum.time_analyze);
 
   auto factor_at = [&](double sigma) {
     auto tf = Clock::now();
@@ -540,6 +572,7 @@ EigenSolution solve_eigen(const SparseMatrix& K, const SparseMatrix& M, const Ei
                   std::to_string(band_count);
   }
   sum.status = converged ? EigenStatus::kSuccess : EigenStatus::kNotConverged;
+  cache_->llt_valid = !band && nev > 0;  // F holds K - sigma M (LL^T)
   report(opt, "done", 1.0);
   return sol;
 }

@@ -37,6 +37,8 @@ class CholmodFactor {
   /// A^{-1} = backward o forward. Used to turn K phi = lambda M phi into a standard symmetric problem.
   void forward(const double* b, double* x) const;
   void backward(const double* b, double* x) const;
+  /// X = A^{-1} B for the k columns of B at once (blocked, BLAS-3).
+  void solve_block(const Eigen::MatrixXd& B, Eigen::MatrixXd* X) const;
   /// backward() for the k columns of B at once (blocked, BLAS-3): X = P^T L^{-T} B.
   void backward_block(const Eigen::MatrixXd& B, Eigen::MatrixXd* X) const;
   /// Row/column of A (original numbering) at which the last factorize() broke down, or -1.

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <memory>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -19,6 +20,8 @@
 #include "dynid/solvers/sparse.hpp"
 
 namespace dynid {
+
+class CholmodFactor;
 
 struct EigenOptions {
   /// Number of lowest modes wanted, rigid-body modes included. Ignored in band mode.
@@ -90,6 +93,27 @@ struct EigenSolution {
 /// Solves K phi = lambda M phi for the lowest num_modes modes (or a band). Never throws for numerical failures:
 /// they come back in summary.status / message. Throws InputError for invalid options or mismatched matrices.
 EigenSolution solve_eigen(const SparseMatrix& K, const SparseMatrix& M, const EigenOptions& options);
+
+/// The same, for repeated solves (model updating, nonlinear refinement): the symbolic analysis of K - sigma M
+/// (fill-reducing ordering, supernodes) is kept and reused while the sparsity pattern stays the same, so each
+/// further solve costs a numeric factorization and the Lanczos run. One object per thread.
+class EigenSolver {
+ public:
+  explicit EigenSolver(const EigenOptions& options);
+  ~EigenSolver();
+  EigenSolver(const EigenSolver&) = delete;
+  EigenSolver& operator=(const EigenSolver&) = delete;
+  EigenSolution solve(const SparseMatrix& K, const SparseMatrix& M);
+  EigenOptions& options() { return options_; }
+  /// The LL^T factorization of K - sigma M from the last sparse lowest-modes solve (sigma = its
+  /// summary.shift), or nullptr (dense path, band mode, failure). Valid until the next solve.
+  const CholmodFactor* factor() const;
+
+ private:
+  struct Cache;
+  std::unique_ptr<Cache> cache_;
+  EigenOptions options_;
+};
 
 /// Dense reference path (O(n^3)); the same options and result conventions.
 EigenSolution solve_eigen_dense(const Eigen::MatrixXd& K, const Eigen::MatrixXd& M, const EigenOptions& options);

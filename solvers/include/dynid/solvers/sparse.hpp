@@ -41,6 +41,12 @@ class Assembler {
 /// Parallel y = A x for a matrix stored with both triangles (uses symmetry: row i = column i). Deterministic.
 void symmetric_multiply(const SparseMatrix& A, const double* x, double* y);
 
+/// Residual forces R = -K Phi + M Phi diag(lambda) (column i: (-K + lambda_i M) phi_i, eq. (6) of the paper) for
+/// K and M stored in full with the same pattern. OpenMP-parallel over rows, deterministic (each entry is one
+/// sum in a fixed order whatever the thread count).
+void residual_forces(const SparseMatrix& K, const SparseMatrix& M, const Eigen::MatrixXd& Phi,
+                     const Eigen::VectorXd& lambda, Eigen::MatrixXd* R);
+
 /// The 1-norm of a sparse matrix (max column sum of absolute values).
 double norm1(const SparseMatrix& A);
 

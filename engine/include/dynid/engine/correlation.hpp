@@ -1,0 +1,41 @@
+// dynid/engine/correlation.hpp -- test/analysis correlation: MAC, mode pairing, COMAC, frequency errors.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace dynid {
+
+/// MAC(i, j) = (a_i . b_j)^2 / ((a_i . a_i)(b_j . b_j)) for the columns of A (dofs x ma) and B (dofs x mb).
+/// 1 = same shape up to scale and sign, 0 = orthogonal. A zero column gives MAC 0.
+Eigen::MatrixXd mac_matrix(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B);
+
+struct ModePair {
+  int a = 0;              ///< column in A (e.g. the measured mode)
+  int b = 0;              ///< column in B (e.g. the model mode)
+  double mac = 0;
+  double freq_error = 0;  ///< (f_b - f_a) / f_a
+};
+
+struct Pairing {
+  std::vector<ModePair> pairs;  ///< sorted by a
+  std::vector<int> unpaired_a;  ///< columns of A with no partner of MAC >= min_mac
+  std::vector<int> unpaired_b;
+  /// Pair of column a, or nullptr.
+  const ModePair* of_a(int a) const;
+};
+
+/// One-to-one pairing by MAC: repeatedly takes the pair with the highest score MAC - 0.1 min(1, |f_b - f_a|/f_a)
+/// (MAC decides; the frequency breaks near-ties such as the twin modes of symmetric structures), among pairs
+/// with MAC >= min_mac. fa, fb may be empty (no frequency tie-break).
+Pairing pair_modes(const Eigen::MatrixXd& mac, const Eigen::VectorXd& fa, const Eigen::VectorXd& fb,
+                   double min_mac = 0.5);
+
+/// COMAC per DOF over the paired modes: (sum_k |a_ik b_ik|)^2 / (sum_k a_ik^2 sum_k b_ik^2), shapes scaled to
+/// their MAC-consistent sign. 1 = the DOF agrees in every pair.
+Eigen::VectorXd comac(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Pairing& p);
+
+/// Scale factor s minimising ||a - s b|| (modal scale factor, MSF).
+double modal_scale_factor(const Eigen::VectorXd& a, const Eigen::VectorXd& b);
+
+}  // namespace dynid

@@ -1,0 +1,47 @@
+// dynid/engine/modal_data.hpp -- modal data at measured DOFs (a test, or a simulation sampled like one).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "dynid/engine/modal.hpp"
+#include "dynid/mesh/model.hpp"
+
+namespace dynid {
+
+/// A measured DOF: a node (user id) and a direction.
+struct MeasuredDof {
+  int node = 0;
+  Dof dof = Dof::UY;
+  bool operator==(const MeasuredDof& o) const { return node == o.node && dof == o.dof; }
+};
+std::string to_string(const MeasuredDof& d);  // "14uy"
+
+/// Frequencies and real mode shapes at a set of DOFs. Shapes may have any scaling and sign.
+struct ModalData {
+  std::vector<MeasuredDof> dofs;   ///< rows of `shapes`
+  Eigen::VectorXd frequencies_hz;  ///< one per mode (column of `shapes`)
+  Eigen::MatrixXd shapes;          ///< dofs x modes
+  Eigen::VectorXd damping_ratios;  ///< optional (empty or one per mode)
+  std::string source;              ///< where it came from (file, "simulation of ...")
+  int num_modes() const { return static_cast<int>(frequencies_hz.size()); }
+  /// Throws InputError if sizes disagree or values are not finite / frequencies not positive.
+  void validate(const std::string& what) const;
+};
+
+/// Equation numbers of measured DOFs in a model. Throws InputError naming the DOF when a node does not exist,
+/// or the DOF is not a DOF of the model (inactive or restrained), with what the node does have.
+std::vector<int> measured_equations(const Model& model, const std::vector<MeasuredDof>& dofs);
+
+/// Every free DOF of a model, in equation order.
+std::vector<MeasuredDof> all_dofs(const Model& model);
+/// The free DOFs of the given types (e.g. translations) at every node (or at `nodes` if not empty).
+std::vector<MeasuredDof> dofs_of_types(const Model& model, DofMask types, const std::vector<int>& nodes = {});
+
+/// A model's modes sampled at DOFs, as a test would see them: `first` is the first mode taken (0-based, e.g. 2
+/// to skip two rigid-body modes), `count` modes. Shapes are the mass-normalised mode shapes at those DOFs.
+ModalData sample_modes(const Model& model, const ModalResult& modes, const std::vector<MeasuredDof>& dofs,
+                       int first, int count, const std::string& source);
+
+}  // namespace dynid

@@ -1,0 +1,88 @@
+// dynid/engine/model_fit.hpp -- fitting a ParametricModel to measured modal data with Ceres Solver
+// (Levenberg-Marquardt or dogleg trust region, bounds, analytic Jacobians, covariance).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "dynid/engine/modal_data.hpp"
+#include "dynid/engine/parametric.hpp"
+
+namespace dynid {
+
+/// Residuals, per measured mode k paired (by MAC) with model mode i at the current parameters:
+///  kFrequency     (lambda_i - lambda_k) / s_k                          s_k = 2 frequency_noise lambda_k
+///  kFrequencyMac  (lambda_i - lambda_k) / (s_k MAC_ik)                 the paper's f1 (eq. 2) as least squares
+///  kCombined      kFrequency plus (c phi_i - u_k) / shape_noise at the measured DOFs, u_k the measured shape
+///                 scaled to a largest entry of 1, c the least-squares scale
+///  kSerep         the paper's f2: (K~ - lambda_k M~) u_k on the model reduced by SEREP to the measured DOFs
+///                 (K~, M~ from the model's modes at the current parameters), scaled per mode
+/// Frequency and shape noise are standard deviations (relative); with them the residuals are whitened and the
+/// parameter covariance is meaningful.
+enum class FitObjective { kFrequency, kFrequencyMac, kCombined, kSerep };
+std::string_view fit_objective_name(FitObjective o);  // "frequency", "f1", "combined", "f2"
+
+struct FitOptions {
+  FitObjective objective = FitObjective::kCombined;
+  double frequency_noise = 1e-3;  ///< relative std of measured frequencies
+  double shape_noise = 1e-2;      ///< std of shape entries relative to each mode's largest entry
+  double regularization = 0.0;    ///< Tikhonov weight w: residuals sqrt(w) (theta_p - nominal_p) / scale_p
+  enum class Loss { kNone, kHuber, kCauchy };
+  Loss loss = Loss::kNone;        ///< robust loss per measured mode, on the whitened residual
+  double loss_scale = 3.0;        ///< in units of the noise std
+  bool dogleg = false;            ///< trust-region dogleg instead of Levenberg-Marquardt
+  int max_iterations = 100;
+  double function_tolerance = 1e-12, parameter_tolerance = 1e-10, gradient_tolerance = 1e-14;
+  double min_mac = 0.5;           ///< pairing threshold
+  int extra_modes = 10;           ///< model modes computed beyond the measured ones (pairing, expansion)
+  bool covariance = true;
+  bool IsValid(std::string* why) const;
+};
+
+struct FitSummary {
+  Eigen::VectorXd theta;        ///< all parameters (fixed ones unchanged)
+  Eigen::VectorXd stddev;       ///< from the Ceres covariance; NaN where not estimable (or fixed)
+  bool covariance_ok = false;
+  int covariance_rank = 0;      ///< rank of J^T J over the free parameters
+  int free_parameters = 0;
+  std::vector<double> cost_history;  ///< Ceres cost (1/2 sum r^2) per iteration, starting with the initial
+  int iterations = 0;
+  int evaluations = 0;          ///< model evaluations (eigen-solves)
+  std::string termination;      ///< Ceres termination: CONVERGENCE, NO_CONVERGENCE, FAILURE, ...
+  bool converged = false;
+  double initial_cost = 0, final_cost = 0;
+  Eigen::VectorXd measured_hz, initial_hz, final_hz;  ///< per measured mode (paired model modes)
+  Eigen::VectorXd initial_mac, final_mac;
+  std::vector<int> at_bound;    ///< parameters that ended on a bound
+  std::vector<std::string> warnings;
+  std::string report;           ///< Ceres FullReport()
+};
+
+/// Fits the parameters marked free (all if `free` is empty) starting from theta0. Throws InputError on
+/// invalid options or data that does not match the model.
+FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta0,
+                          const std::vector<char>& free, const FitOptions& options);
+
+/// The whitened residuals r(theta) (stacked mode by mode, as fit_parameters builds them) and the Jacobian
+/// J = dr/dtheta for every parameter, from one model evaluation: for screening many candidate parameter subsets
+/// (e.g. one element at a time) at the cost of one eigen-solve.
+struct Linearization {
+  Eigen::VectorXd r;
+  Eigen::MatrixXd J;               ///< rows of r x all parameters
+  std::vector<int> block_start;    ///< first row of each measured mode's block
+  Eigen::VectorXd model_hz, mac;   ///< paired model frequencies and MAC per measured mode
+  std::vector<char> forced;        ///< mode paired below min_mac
+};
+Linearization linearize(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta,
+                        const FitOptions& options);
+
+/// One evaluation of the model against measured data (no fitting): frequencies and MAC of the paired modes.
+struct Correlation {
+  Eigen::VectorXd measured_hz, model_hz, mac;
+  std::vector<int> model_mode;  ///< paired elastic model mode (0-based, rigid modes not counted), -1 if none
+};
+Correlation correlate(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta,
+                      double min_mac = 0.5);
+
+}  // namespace dynid

@@ -1,0 +1,87 @@
+#include "dynid/engine/modal_data.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "dynid/mesh/error.hpp"
+
+namespace dynid {
+
+std::string to_string(const MeasuredDof& d) { return std::to_string(d.node) + std::string(dof_name(d.dof)); }
+
+void ModalData::validate(const std::string& what) const {
+  const Eigen::Index m = frequencies_hz.size();
+  if (shapes.cols() != m)
+    throw InputError(what + ": " + std::to_string(m) + " frequencies but " + std::to_string(shapes.cols()) + " mode shapes");
+  if (shapes.rows() != static_cast<Eigen::Index>(dofs.size()))
+    throw InputError(what + ": mode shapes have " + std::to_string(shapes.rows()) + " rows for " +
+                     std::to_string(dofs.size()) + " DOFs");
+  if (damping_ratios.size() != 0 && damping_ratios.size() != m)
+    throw InputError(what + ": " + std::to_string(damping_ratios.size()) + " damping ratios for " + std::to_string(m) + " modes");
+  for (Eigen::Index k = 0; k < m; ++k) {
+    if (!std::isfinite(frequencies_hz[k]) || frequencies_hz[k] <= 0)
+      throw InputError(what + ": mode " + std::to_string(k + 1) + " has frequency " + std::to_string(frequencies_hz[k]) +
+                       " Hz; frequencies must be finite and > 0 (leave rigid-body modes out)");
+    if (!shapes.col(k).allFinite())
+      throw InputError(what + ": mode " + std::to_string(k + 1) + " has a NaN or Inf shape entry");
+    if (shapes.col(k).squaredNorm() == 0) throw InputError(what + ": mode " + std::to_string(k + 1) + " has an all-zero shape");
+  }
+  for (std::size_t i = 0; i < dofs.size(); ++i)
+    for (std::size_t j = i + 1; j < dofs.size(); ++j)
+      if (dofs[i] == dofs[j]) throw InputError(what + ": DOF " + to_string(dofs[i]) + " is listed twice");
+}
+
+std::vector<int> measured_equations(const Model& model, const std::vector<MeasuredDof>& dofs) {
+  std::vector<int> eq;
+  eq.reserve(dofs.size());
+  for (const MeasuredDof& d : dofs) {
+    const int n = model.node_index(d.node);
+    if (n < 0) throw InputError("measured DOF " + to_string(d) + ": node " + std::to_string(d.node) + " is not in the model");
+    const int e = model.dof_map().eq(n, d.dof);
+    if (e < 0) {
+      const DofMask act = model.dof_map().active(n), res = model.dof_map().restrained(n);
+      std::string why = has_dof(res, d.dof) ? "is restrained (a support)" : "is not a DOF of the model";
+      throw InputError("measured DOF " + to_string(d) + ": " + std::string(dof_name(d.dof)) + " at node " +
+                       std::to_string(d.node) + " " + why + "; the node's free DOFs are: " +
+                       (dof_mask_string(act & ~res).empty() ? "none" : dof_mask_string(act & ~res)));
+    }
+    eq.push_back(e);
+  }
+  return eq;
+}
+
+std::vector<MeasuredDof> all_dofs(const Model& model) {
+  std::vector<MeasuredDof> out;
+  const DofMap& dm = model.dof_map();
+  for (int i = 0; i < dm.num_free(); ++i) out.push_back({model.nodes()[dm.node_of(i)].id, dm.type_of(i)});
+  return out;
+}
+
+std::vector<MeasuredDof> dofs_of_types(const Model& model, DofMask types, const std::vector<int>& nodes) {
+  std::vector<MeasuredDof> out;
+  const DofMap& dm = model.dof_map();
+  for (int i = 0; i < dm.num_free(); ++i) {
+    if (!has_dof(types, dm.type_of(i))) continue;
+    const int id = model.nodes()[dm.node_of(i)].id;
+    if (!nodes.empty() && std::find(nodes.begin(), nodes.end(), id) == nodes.end()) continue;
+    out.push_back({id, dm.type_of(i)});
+  }
+  return out;
+}
+
+ModalData sample_modes(const Model& model, const ModalResult& modes, const std::vector<MeasuredDof>& dofs,
+                       int first, int count, const std::string& source) {
+  if (first < 0 || count < 1 || first + count > modes.eigenvalues.size())
+    throw InputError("sample_modes: modes " + std::to_string(first + 1) + ".." + std::to_string(first + count) +
+                     " requested, " + std::to_string(modes.eigenvalues.size()) + " computed");
+  const std::vector<int> eq = measured_equations(model, dofs);
+  ModalData d;
+  d.dofs = dofs;
+  d.source = source;
+  d.frequencies_hz = modes.frequencies_hz.segment(first, count);
+  d.shapes.resize(static_cast<Eigen::Index>(eq.size()), count);
+  for (std::size_t i = 0; i < eq.size(); ++i) d.shapes.row(static_cast<Eigen::Index>(i)) = modes.modes.row(eq[i]).segment(first, count);
+  return d;
+}
+
+}  // namespace dynid

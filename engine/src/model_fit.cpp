@@ -1,0 +1,566 @@
+#include "dynid/engine/model_fit.hpp"
+
+#include <ceres/ceres.h>
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <sstream>
+
+#include "dynid/engine/correlation.hpp"
+#include "dynid/engine/sensitivity.hpp"
+#include "dynid/mesh/error.hpp"
+#include "dynid/solvers/eigen.hpp"
+
+namespace dynid {
+
+std::string_view fit_objective_name(FitObjective o) {
+  switch (o) {
+    case FitObjective::kFrequency: return "frequency";
+    case FitObjective::kFrequencyMac: return "f1";
+    case FitObjective::kCombined: return "combined";
+    case FitObjective::kSerep: return "f2";
+  }
+  return "?";
+}
+
+bool FitOptions::IsValid(std::string* why) const {
+  auto fail = [&](const char* m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (!(frequency_noise > 0)) return fail("frequency_noise must be > 0");
+  if (!(shape_noise > 0)) return fail("shape_noise must be > 0");
+  if (!(regularization >= 0)) return fail("regularization must be >= 0");
+  if (!(loss_scale > 0)) return fail("loss_scale must be > 0");
+  if (max_iterations < 0) return fail("max_iterations must be >= 0");
+  if (!(min_mac >= 0 && min_mac <= 1)) return fail("min_mac must be in [0, 1]");
+  if (extra_modes < 0) return fail("extra_modes must be >= 0");
+  return true;
+}
+
+namespace {
+
+// One evaluation of the model at theta against the measured modes: residual block and Jacobian per mode.
+struct Evaluation {
+  bool ok = false;
+  std::string error;
+  ModalState ms;
+  std::vector<int> elastic;     // indices of elastic modes in ms
+  std::vector<int> pair;        // measured k -> index in ms
+  std::vector<char> forced;     // the pairing fell back to the best available MAC below min_mac
+  Eigen::VectorXd mac;
+  std::vector<Eigen::VectorXd> r;
+  std::vector<Eigen::MatrixXd> J;  // rows x free parameters
+  bool has_jacobian = false;
+};
+
+class Evaluator {
+ public:
+  Evaluator(const ParametricModel& pm, const ModalData& meas, const Eigen::VectorXd& theta0, std::vector<int> free,
+            const FitOptions& o)
+      : pm_(pm), meas_(meas), theta0_(theta0), free_(std::move(free)), o_(o), solver_(EigenOptions{}) {
+    rows_ = measured_equations(pm.model(), meas.dofs);
+    const Model& model = pm.model();
+    const int n = model.num_dofs();
+    bool springs = false;
+    for (int p = 0; p < pm.num_parameters(); ++p) springs = springs || pm.parameter(p).kind == ParameterKind::kSpring;
+    EigenOptions& eo = solver_.options();
+    if (model.free_free() && !springs) eo.rigid_body_basis = model.free_rigid_body_modes();
+    if (model.free_free() && springs) eo.allow_singular_stiffness = true;
+    const int p = meas.num_modes();
+    const int rigid = static_cast<int>(eo.rigid_body_basis.cols());
+    int want = rigid + p + o.extra_modes;
+    if (o.objective == FitObjective::kSerep) want = std::max(want, static_cast<int>(rows_.size()) + rigid);
+    if (n <= 400) {  // small model: every mode, dense, exact expansions
+      eo.method = EigenOptions::Method::kDense;
+      eo.num_modes = n;
+      complete_ = true;
+    } else {
+      eo.method = EigenOptions::Method::kSparse;
+      eo.num_modes = std::min(want, n - 1);
+    }
+    // Measured shapes scaled to a largest entry of 1 (the shape noise is relative to it).
+    U_ = meas.shapes;
+    for (Eigen::Index k = 0; k < U_.cols(); ++k) U_.col(k) /= U_.col(k).cwiseAbs().maxCoeff();
+    lam_meas_.resize(p);
+    for (int k = 0; k < p; ++k) lam_meas_[k] = hz_to_eigenvalue(meas.frequencies_hz[k]);
+    m_serep_ = std::min<int>(static_cast<int>(rows_.size()), eo.num_modes);
+  }
+
+  Eigen::VectorXd theta_of(const double* x) const {
+    Eigen::VectorXd t = theta0_;
+    for (std::size_t k = 0; k < free_.size(); ++k) t[free_[k]] = x[k];
+    return t;
+  }
+  int rows_per_mode() const {
+    switch (o_.objective) {
+      case FitObjective::kCombined: return 1 + static_cast<int>(rows_.size());
+      case FitObjective::kSerep: return static_cast<int>(rows_.size());
+      default: return 1;
+    }
+  }
+  int evaluations() const { return evaluations_; }
+  const std::vector<int>& rows() const { return rows_; }
+
+  const Evaluation& at(const double* x, bool jacobian) {
+    const Eigen::Index nf = static_cast<Eigen::Index>(free_.size());
+    const bool same = cached_ && Eigen::Map<const Eigen::VectorXd>(x, nf) == last_x_;
+    if (!same) {
+      last_x_ = Eigen::Map<const Eigen::VectorXd>(x, nf);
+      cached_ = true;
+      solve(theta_of(x));
+    }
+    if (jacobian && ev_.ok && !ev_.has_jacobian) jacobians();
+    return ev_;
+  }
+
+ private:
+  void solve(const Eigen::VectorXd& theta) {
+    ev_ = Evaluation{};
+    ++evaluations_;
+    SparseMatrix K, M;
+    pm_.matrices(theta, &K, &M);
+    EigenSolution s = solver_.solve(K, M);
+    if (!s.summary.ok()) {
+      ev_.error = s.summary.message;
+      return;
+    }
+    ev_.ms.theta = theta;
+    ev_.ms.lambda = s.eigenvalues;
+    ev_.ms.Phi = std::move(s.modes);
+    ev_.ms.complete = complete_;
+    ev_.ms.factor = solver_.factor();
+    ev_.ms.sigma = s.summary.shift;
+    if (!complete_ && !ev_.ms.factor) {
+      ev_.error = "no factorization available for the sensitivities";
+      return;
+    }
+    for (Eigen::Index j = 0; j < ev_.ms.lambda.size(); ++j)
+      if (!s.rigid_body[j]) ev_.elastic.push_back(static_cast<int>(j));
+    const Eigen::Index a = static_cast<Eigen::Index>(rows_.size());
+    Eigen::MatrixXd Pa(a, static_cast<Eigen::Index>(ev_.elastic.size()));
+    Eigen::VectorXd fe(static_cast<Eigen::Index>(ev_.elastic.size()));
+    for (std::size_t j = 0; j < ev_.elastic.size(); ++j) {
+      for (Eigen::Index r = 0; r < a; ++r) Pa(r, static_cast<Eigen::Index>(j)) = ev_.ms.Phi(rows_[r], ev_.elastic[j]);
+      fe[static_cast<Eigen::Index>(j)] = eigenvalue_to_hz(ev_.ms.lambda[ev_.elastic[j]]);
+    }
+    const Eigen::MatrixXd mac = mac_matrix(meas_.shapes, Pa);
+    const Pairing pr = pair_modes(mac, meas_.frequencies_hz, fe, o_.min_mac);
+    const int p = meas_.num_modes();
+    ev_.pair.assign(p, -1);
+    ev_.forced.assign(p, 0);
+    std::vector<char> used(ev_.elastic.size(), 0);
+    for (const ModePair& q : pr.pairs) {
+      ev_.pair[q.a] = ev_.elastic[q.b];
+      used[q.b] = 1;
+    }
+    for (int k = 0; k < p; ++k) {  // unpaired: best remaining MAC, flagged
+      if (ev_.pair[k] >= 0) continue;
+      int best = -1;
+      for (std::size_t j = 0; j < ev_.elastic.size(); ++j)
+        if (!used[j] && (best < 0 || mac(k, static_cast<Eigen::Index>(j)) > mac(k, best))) best = static_cast<int>(j);
+      if (best < 0) {
+        ev_.error = "measured mode " + std::to_string(k + 1) + " has no model mode left to pair with";
+        return;
+      }
+      used[best] = 1;
+      ev_.pair[k] = ev_.elastic[best];
+      ev_.forced[k] = 1;
+    }
+    ev_.mac.resize(p);
+    for (int k = 0; k < p; ++k) {
+      int j = 0;
+      while (ev_.elastic[j] != ev_.pair[k]) ++j;
+      ev_.mac[k] = mac(k, j);
+    }
+    residuals();
+    ev_.ok = true;
+  }
+
+  double sigma_lambda(int k) const { return 2.0 * o_.frequency_noise * lam_meas_[k]; }
+
+  void residuals() {
+    const int p = meas_.num_modes();
+    const Eigen::Index a = static_cast<Eigen::Index>(rows_.size());
+    ev_.r.assign(p, Eigen::VectorXd());
+    if (o_.objective == FitObjective::kSerep) {
+      serep_prepare();
+      for (int k = 0; k < p; ++k) {
+        const Eigen::VectorXd x = Ps_ * U_.col(k);
+        const Eigen::VectorXd r = Ps_.transpose() * ((lam_m_.array() - lam_meas_[k]).matrix().cwiseProduct(x));
+        if (serep_scale_.size() != p) serep_scale_.resize(p);
+        if (!serep_scaled_) serep_scale_[k] = lam_meas_[k] * (Ps_.transpose() * (Ps_ * U_.col(k))).norm() * o_.shape_noise;
+        ev_.r[k] = r / serep_scale_[k];
+      }
+      serep_scaled_ = true;
+      return;
+    }
+    for (int k = 0; k < p; ++k) {
+      const int i = ev_.pair[k];
+      const double li = ev_.ms.lambda[i];
+      double rf = (li - lam_meas_[k]) / sigma_lambda(k);
+      if (o_.objective == FitObjective::kFrequencyMac) rf /= std::max(ev_.mac[k], 1e-3);
+      if (o_.objective != FitObjective::kCombined) {
+        ev_.r[k] = Eigen::VectorXd::Constant(1, rf);
+        continue;
+      }
+      Eigen::VectorXd v(a);
+      for (Eigen::Index r = 0; r < a; ++r) v[r] = ev_.ms.Phi(rows_[r], i);
+      const double c = U_.col(k).dot(v) / v.squaredNorm();
+      ev_.r[k].resize(1 + a);
+      ev_.r[k][0] = rf;
+      ev_.r[k].tail(a) = (c * v - U_.col(k)) / o_.shape_noise;
+    }
+  }
+
+  // SEREP of the current model to the measured DOFs with the lowest m modes: P = Phi_a^+ (m x a).
+  void serep_prepare() {
+    const Eigen::Index a = static_cast<Eigen::Index>(rows_.size()), m = m_serep_;
+    Phi_a_.resize(a, m);
+    lam_m_.resize(m);
+    for (Eigen::Index j = 0; j < m; ++j) {
+      lam_m_[j] = ev_.ms.lambda[j];
+      for (Eigen::Index r = 0; r < a; ++r) Phi_a_(r, j) = ev_.ms.Phi(rows_[r], j);
+    }
+    G_ = (Phi_a_.transpose() * Phi_a_).inverse();
+    Ps_ = G_ * Phi_a_.transpose();
+  }
+
+  void jacobians() {
+    const int p = meas_.num_modes();
+    const Eigen::Index nf = static_cast<Eigen::Index>(free_.size());
+    const Eigen::Index a = static_cast<Eigen::Index>(rows_.size());
+    ev_.J.assign(p, Eigen::MatrixXd());
+    if (o_.objective == FitObjective::kSerep) {
+      const Eigen::Index m = m_serep_;
+      std::vector<int> modes(static_cast<std::size_t>(m));
+      for (Eigen::Index j = 0; j < m; ++j) modes[j] = static_cast<int>(j);
+      const Eigen::MatrixXd dlam = eigenvalue_derivatives(pm_, ev_.ms, modes);          // m x P
+      const std::vector<Eigen::MatrixXd> dphi = shape_derivatives(pm_, ev_.ms, modes, rows_);  // m of (a x P)
+      for (int k = 0; k < p; ++k) {
+        const Eigen::VectorXd u = U_.col(k);
+        const Eigen::VectorXd x = Ps_ * u;
+        const Eigen::VectorXd lx = (lam_m_.array() - lam_meas_[k]).matrix().cwiseProduct(x);
+        Eigen::MatrixXd Jk(a, nf);
+        for (Eigen::Index f = 0; f < nf; ++f) {
+          const int q = free_[f];
+          Eigen::MatrixXd dPa(a, m);
+          for (Eigen::Index j = 0; j < m; ++j) dPa.col(j) = dphi[j].col(q);
+          // d(Phi_a^+) for full column rank: -P dPa P + G dPa^T (I - Phi_a P).
+          const Eigen::MatrixXd dP = -Ps_ * dPa * Ps_ + G_ * dPa.transpose() * (Eigen::MatrixXd::Identity(a, a) - Phi_a_ * Ps_);
+          const Eigen::VectorXd dx = dP * u;
+          const Eigen::VectorXd dl = dlam.col(q);
+          const Eigen::VectorXd dr = dP.transpose() * lx + Ps_.transpose() * (dl.cwiseProduct(x) + (lam_m_.array() - lam_meas_[k]).matrix().cwiseProduct(dx));
+          Jk.col(f) = dr / serep_scale_[k];
+        }
+        ev_.J[k] = Jk;
+      }
+      ev_.has_jacobian = true;
+      return;
+    }
+    std::vector<int> modes(ev_.pair.begin(), ev_.pair.end());
+    const Eigen::MatrixXd dlam = eigenvalue_derivatives(pm_, ev_.ms, modes);
+    std::vector<Eigen::MatrixXd> dphi;
+    if (o_.objective == FitObjective::kCombined) dphi = shape_derivatives(pm_, ev_.ms, modes, rows_);
+    for (int k = 0; k < p; ++k) {
+      double w = 1.0 / sigma_lambda(k);
+      if (o_.objective == FitObjective::kFrequencyMac) w /= std::max(ev_.mac[k], 1e-3);
+      Eigen::MatrixXd Jk(rows_per_mode(), nf);
+      for (Eigen::Index f = 0; f < nf; ++f) Jk(0, f) = dlam(k, free_[f]) * w;
+      if (o_.objective == FitObjective::kCombined) {
+        const int i = ev_.pair[k];
+        Eigen::VectorXd v(a);
+        for (Eigen::Index r = 0; r < a; ++r) v[r] = ev_.ms.Phi(rows_[r], i);
+        const double vv = v.squaredNorm();
+        const double c = U_.col(k).dot(v) / vv;
+        for (Eigen::Index f = 0; f < nf; ++f) {
+          const Eigen::VectorXd dv = dphi[k].col(free_[f]);
+          const double dc = U_.col(k).dot(dv) / vv - 2.0 * c * v.dot(dv) / vv;
+          Jk.col(f).tail(a) = (dc * v + c * dv) / o_.shape_noise;
+        }
+      }
+      ev_.J[k] = Jk;
+    }
+    ev_.has_jacobian = true;
+  }
+
+  const ParametricModel& pm_;
+  const ModalData& meas_;
+  Eigen::VectorXd theta0_;
+  std::vector<int> free_;
+  FitOptions o_;
+  EigenSolver solver_;
+  std::vector<int> rows_;
+  bool complete_ = false;
+  Eigen::MatrixXd U_;
+  Eigen::VectorXd lam_meas_;
+  int m_serep_ = 0;
+  Eigen::MatrixXd Phi_a_, G_, Ps_;
+  Eigen::VectorXd lam_m_, serep_scale_;
+  bool serep_scaled_ = false;
+  Eigen::VectorXd last_x_;
+  bool cached_ = false;
+  Evaluation ev_;
+  int evaluations_ = 0;
+};
+
+class ModeCost : public ceres::CostFunction {
+ public:
+  ModeCost(std::shared_ptr<Evaluator> ev, int k, int nres, int nfree) : ev_(std::move(ev)), k_(k) {
+    set_num_residuals(nres);
+    mutable_parameter_block_sizes()->push_back(nfree);
+  }
+  bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
+    const bool want = jacobians != nullptr && jacobians[0] != nullptr;
+    const Evaluation& e = ev_->at(params[0], want);
+    if (!e.ok) return false;
+    Eigen::Map<Eigen::VectorXd>(residuals, num_residuals()) = e.r[k_];
+    if (want) {
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+          jacobians[0], num_residuals(), parameter_block_sizes()[0]) = e.J[k_];
+    }
+    return true;
+  }
+
+ private:
+  std::shared_ptr<Evaluator> ev_;
+  int k_;
+};
+
+// Tikhonov regularisation toward the nominal values: sqrt(w) (theta_p - nominal_p) / scale_p.
+class PriorCost : public ceres::CostFunction {
+ public:
+  PriorCost(Eigen::VectorXd nominal, Eigen::VectorXd weight) : nominal_(std::move(nominal)), w_(std::move(weight)) {
+    set_num_residuals(static_cast<int>(nominal_.size()));
+    mutable_parameter_block_sizes()->push_back(static_cast<int>(nominal_.size()));
+  }
+  bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
+    const Eigen::Index n = nominal_.size();
+    for (Eigen::Index i = 0; i < n; ++i) residuals[i] = w_[i] * (params[0][i] - nominal_[i]);
+    if (jacobians && jacobians[0]) {
+      std::fill(jacobians[0], jacobians[0] + n * n, 0.0);
+      for (Eigen::Index i = 0; i < n; ++i) jacobians[0][i * n + i] = w_[i];
+    }
+    return true;
+  }
+
+ private:
+  Eigen::VectorXd nominal_, w_;
+};
+
+class CostRecorder : public ceres::IterationCallback {
+ public:
+  explicit CostRecorder(std::vector<double>* h) : h_(h) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    h_->push_back(s.cost);
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  std::vector<double>* h_;
+};
+
+Eigen::VectorXd paired_hz(const Evaluation& e) {
+  Eigen::VectorXd f(static_cast<Eigen::Index>(e.pair.size()));
+  for (std::size_t k = 0; k < e.pair.size(); ++k) f[static_cast<Eigen::Index>(k)] = eigenvalue_to_hz(e.ms.lambda[e.pair[k]]);
+  return f;
+}
+
+}  // namespace
+
+FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta0,
+                          const std::vector<char>& is_free, const FitOptions& o) {
+  std::string why;
+  if (!o.IsValid(&why)) throw InputError("fit options: " + why);
+  measured.validate("measured modal data");
+  if (theta0.size() != pm.num_parameters())
+    throw InputError("fit: " + std::to_string(theta0.size()) + " start values for " + std::to_string(pm.num_parameters()) + " parameters");
+  if (!is_free.empty() && static_cast<int>(is_free.size()) != pm.num_parameters())
+    throw InputError("fit: free-parameter mask has the wrong size");
+  std::vector<int> free;
+  for (int p = 0; p < pm.num_parameters(); ++p)
+    if (is_free.empty() || is_free[p]) free.push_back(p);
+  if (free.empty()) throw InputError("fit: no free parameters");
+  for (int p = 0; p < pm.num_parameters(); ++p) {
+    const Parameter& q = pm.parameter(p);
+    if (!(theta0[p] >= q.lower && theta0[p] <= q.upper))
+      throw InputError("fit: start value of parameter '" + q.name + "' is outside its bounds");
+  }
+  auto ev = std::make_shared<Evaluator>(pm, measured, theta0, free, o);
+  const int nf = static_cast<int>(free.size());
+  std::vector<double> x(free.size());
+  for (int k = 0; k < nf; ++k) x[k] = theta0[free[k]];
+
+  FitSummary out;
+  out.free_parameters = nf;
+  const Evaluation& e0 = ev->at(x.data(), false);
+  if (!e0.ok) throw NumericalError("fit: the model cannot be evaluated at the start values: " + e0.error);
+  out.measured_hz = measured.frequencies_hz;
+  out.initial_hz = paired_hz(e0);
+  out.initial_mac = e0.mac;
+
+  ceres::Problem::Options po;
+  po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  po.loss_function_ownership = ceres::TAKE_OWNERSHIP;
+  ceres::Problem problem(po);
+  for (int k = 0; k < measured.num_modes(); ++k) {
+    ceres::LossFunction* loss = nullptr;
+    const double s2 = o.loss_scale * o.loss_scale;
+    if (o.loss == FitOptions::Loss::kHuber) loss = new ceres::HuberLoss(s2);
+    if (o.loss == FitOptions::Loss::kCauchy) loss = new ceres::CauchyLoss(s2);
+    problem.AddResidualBlock(new ModeCost(ev, k, ev->rows_per_mode(), nf), loss, x.data());
+  }
+  if (o.regularization > 0) {
+    Eigen::VectorXd nom(nf), w(nf);
+    for (int k = 0; k < nf; ++k) {
+      nom[k] = pm.parameter(free[k]).nominal;
+      w[k] = std::sqrt(o.regularization) / pm.parameter(free[k]).scale;
+    }
+    problem.AddResidualBlock(new PriorCost(nom, w), nullptr, x.data());
+  }
+  for (int k = 0; k < nf; ++k) {
+    const Parameter& q = pm.parameter(free[k]);
+    if (std::isfinite(q.lower)) problem.SetParameterLowerBound(x.data(), k, q.lower);
+    if (std::isfinite(q.upper)) problem.SetParameterUpperBound(x.data(), k, q.upper);
+  }
+  ceres::Solver::Options so;
+  so.trust_region_strategy_type = o.dogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = o.max_iterations;
+  so.function_tolerance = o.function_tolerance;
+  so.parameter_tolerance = o.parameter_tolerance;
+  so.gradient_tolerance = o.gradient_tolerance;
+  so.logging_type = ceres::SILENT;
+  so.minimizer_progress_to_stdout = false;
+  so.num_threads = 1;
+  CostRecorder rec(&out.cost_history);
+  so.callbacks.push_back(&rec);
+  so.update_state_every_iteration = false;
+  ceres::Solver::Summary sum;
+  ceres::Solve(so, &problem, &sum);
+  out.iterations = static_cast<int>(sum.iterations.size()) - 1;
+  out.termination = ceres::TerminationTypeToString(sum.termination_type);
+  out.converged = sum.termination_type == ceres::CONVERGENCE;
+  out.initial_cost = sum.initial_cost;
+  out.final_cost = sum.final_cost;
+  out.report = sum.FullReport();
+  out.theta = theta0;
+  for (int k = 0; k < nf; ++k) out.theta[free[k]] = x[k];
+
+  const Evaluation& ef = ev->at(x.data(), true);
+  if (!ef.ok) throw NumericalError("fit: the model cannot be evaluated at the solution: " + ef.error);
+  out.final_hz = paired_hz(ef);
+  out.final_mac = ef.mac;
+  for (int k = 0; k < measured.num_modes(); ++k)
+    if (ef.forced[k])
+      out.warnings.push_back("measured mode " + std::to_string(k + 1) + " (" + std::to_string(measured.frequencies_hz[k]) +
+                             " Hz) pairs with no model mode at MAC >= " + std::to_string(o.min_mac) +
+                             "; it was matched to the best remaining one (MAC " + std::to_string(ef.mac[k]) + ")");
+
+  // Covariance from the final Jacobian (whitened residuals): (J^T J)^+ by SVD; rank reported.
+  out.stddev = Eigen::VectorXd::Constant(pm.num_parameters(), std::numeric_limits<double>::quiet_NaN());
+  {
+    Eigen::Index rows = 0;
+    for (const auto& J : ef.J) rows += J.rows();
+    Eigen::MatrixXd J(rows + (o.regularization > 0 ? nf : 0), nf);
+    Eigen::Index r0 = 0;
+    for (const auto& Jk : ef.J) {
+      J.middleRows(r0, Jk.rows()) = Jk;
+      r0 += Jk.rows();
+    }
+    if (o.regularization > 0)
+      for (int k = 0; k < nf; ++k) {
+        J.row(r0 + k).setZero();
+        J(r0 + k, k) = std::sqrt(o.regularization) / pm.parameter(free[k]).scale;
+      }
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeThinV);
+    const Eigen::VectorXd& sv = svd.singularValues();
+    const double tol = 1e-8 * (sv.size() ? sv[0] : 0.0);
+    Eigen::VectorXd inv2 = Eigen::VectorXd::Zero(sv.size());
+    for (Eigen::Index i = 0; i < sv.size(); ++i)
+      if (sv[i] > tol) {
+        inv2[i] = 1.0 / (sv[i] * sv[i]);
+        ++out.covariance_rank;
+      }
+    if (o.covariance) {
+      const Eigen::MatrixXd C = svd.matrixV() * inv2.asDiagonal() * svd.matrixV().transpose();
+      out.covariance_ok = out.covariance_rank == nf;
+      for (int k = 0; k < nf; ++k) {
+        // A parameter is estimable when it is orthogonal to the null space of J.
+        double in_null = 0;
+        for (Eigen::Index i = 0; i < sv.size(); ++i)
+          if (sv[i] <= tol) in_null += svd.matrixV()(k, i) * svd.matrixV()(k, i);
+        if (in_null < 1e-6) out.stddev[free[k]] = std::sqrt(C(k, k));
+      }
+    }
+    if (out.covariance_rank < nf)
+      out.warnings.push_back("the data determine only " + std::to_string(out.covariance_rank) + " of the " +
+                             std::to_string(nf) + " free parameters (J^T J is rank-deficient): the others trade off "
+                             "against each other; fix or tie parameters, or add modes or DOFs");
+  }
+  const int ndata = measured.num_modes() * ev->rows_per_mode();
+  if (nf > ndata)
+    out.warnings.push_back(std::to_string(nf) + " free parameters but only " + std::to_string(ndata) + " data values");
+  for (int k = 0; k < nf; ++k) {
+    const Parameter& q = pm.parameter(free[k]);
+    const double tol = 1e-6 * std::max(1.0, std::abs(q.scale));
+    if ((std::isfinite(q.lower) && x[k] - q.lower < tol) || (std::isfinite(q.upper) && q.upper - x[k] < tol)) {
+      out.at_bound.push_back(free[k]);
+      out.warnings.push_back("parameter '" + q.name + "' ended on its bound (" + std::to_string(x[k]) +
+                             "): the data push it further than allowed");
+    }
+  }
+  out.evaluations = ev->evaluations();
+  return out;
+}
+
+Linearization linearize(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta,
+                        const FitOptions& o) {
+  std::string why;
+  if (!o.IsValid(&why)) throw InputError("fit options: " + why);
+  measured.validate("measured modal data");
+  std::vector<int> all(static_cast<std::size_t>(pm.num_parameters()));
+  for (int p = 0; p < pm.num_parameters(); ++p) all[p] = p;
+  Evaluator ev(pm, measured, theta, all, o);
+  const Evaluation& e = ev.at(theta.data(), true);
+  if (!e.ok) throw NumericalError("linearize: " + e.error);
+  Linearization L;
+  Eigen::Index rows = 0;
+  for (const auto& r : e.r) {
+    L.block_start.push_back(static_cast<int>(rows));
+    rows += r.size();
+  }
+  L.r.resize(rows);
+  L.J.resize(rows, pm.num_parameters());
+  for (std::size_t k = 0; k < e.r.size(); ++k) {
+    L.r.segment(L.block_start[k], e.r[k].size()) = e.r[k];
+    L.J.middleRows(L.block_start[k], e.J[k].rows()) = e.J[k];
+  }
+  L.model_hz = paired_hz(e);
+  L.mac = e.mac;
+  L.forced = e.forced;
+  return L;
+}
+
+Correlation correlate(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta, double min_mac) {
+  FitOptions o;
+  o.objective = FitObjective::kFrequency;
+  o.min_mac = min_mac;
+  Evaluator ev(pm, measured, theta, {}, o);
+  const Evaluation& e = ev.at(nullptr, false);
+  if (!e.ok) throw NumericalError("correlate: " + e.error);
+  Correlation c;
+  c.measured_hz = measured.frequencies_hz;
+  c.model_hz = paired_hz(e);
+  c.mac = e.mac;
+  for (std::size_t k = 0; k < e.pair.size(); ++k) {
+    int j = 0;
+    while (e.elastic[j] != e.pair[k]) ++j;
+    c.model_mode.push_back(e.forced[k] ? -1 : j);
+  }
+  return c;
+}
+
+}  // namespace dynid

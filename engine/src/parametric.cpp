@@ -1,0 +1,232 @@
+#include "dynid/engine/parametric.hpp"
+
+#include <algorithm>
+#include <map>
+
+#include "dynid/engine/modal.hpp"
+#include "dynid/mesh/error.hpp"
+
+namespace dynid {
+
+std::string_view parameter_kind_name(ParameterKind k) {
+  switch (k) {
+    case ParameterKind::kStiffness: return "E";
+    case ParameterKind::kMass: return "rho";
+    case ParameterKind::kArea: return "A";
+    case ParameterKind::kInertia: return "I";
+    case ParameterKind::kPointMass: return "mass";
+    case ParameterKind::kSpring: return "spring";
+  }
+  return "?";
+}
+
+ParametricModel::ParametricModel(const Model& model) : model_(model) {
+  if (!model.finalized()) throw InputError("ParametricModel: the model is not finalized");
+  AssembledSystem s = assemble_system(model);
+  K0_ = std::move(s.K);
+  M0_ = std::move(s.M);
+}
+
+int ParametricModel::add(const Parameter& p) {
+  if (built_) throw InputError("ParametricModel: parameters must be added before the model is evaluated");
+  const std::string who = "parameter '" + p.name + "'";
+  const bool additive = p.kind == ParameterKind::kPointMass || p.kind == ParameterKind::kSpring;
+  if (additive) {
+    if (p.node < 0 || p.node >= static_cast<int>(model_.nodes().size())) throw InputError(who + ": node does not exist");
+    if (p.dofs == 0) throw InputError(who + ": no DOF types given");
+    for (int t = 0; t < kNumDofTypes; ++t)
+      if ((p.dofs & (1u << t)) && model_.dof_map().eq(p.node, static_cast<Dof>(t)) < 0)
+        throw InputError(who + ": " + std::string(dof_name(static_cast<Dof>(t))) + " at node " +
+                         std::to_string(model_.nodes()[p.node].id) + " is not a free DOF of the model");
+  } else {
+    if (p.elements.empty()) throw InputError(who + ": acts on no elements");
+    for (int e : p.elements) {
+      if (e < 0 || e >= model_.num_elements()) throw InputError(who + ": element index " + std::to_string(e) + " does not exist");
+      const ElementType t = model_.elements()[e].type;
+      if (t == ElementType::PointMass || t == ElementType::Spring)
+        throw InputError(who + ": element " + std::to_string(model_.elements()[e].id) +
+                         " is a point mass or spring; factors act on beams and frames");
+    }
+  }
+  if (!(p.lower <= p.nominal && p.nominal <= p.upper))
+    throw InputError(who + ": nominal value " + std::to_string(p.nominal) + " outside its bounds");
+  params_.push_back(p);
+  return static_cast<int>(params_.size()) - 1;
+}
+
+Eigen::VectorXd ParametricModel::nominal() const {
+  Eigen::VectorXd v(num_parameters());
+  for (int p = 0; p < num_parameters(); ++p) v[p] = params_[p].nominal;
+  return v;
+}
+
+void ParametricModel::build() const {
+  if (built_) return;
+  terms_.clear();
+  Kfixed_ = Eigen::Map<const Eigen::VectorXd>(K0_.valuePtr(), K0_.nonZeros());
+  Mfixed_ = Eigen::Map<const Eigen::VectorXd>(M0_.valuePtr(), M0_.nonZeros());
+  auto positions = [&](const std::vector<int>& dofs) {
+    const int nd = static_cast<int>(dofs.size());
+    std::vector<int> pos(static_cast<std::size_t>(nd) * nd, -1);
+    for (int a = 0; a < nd; ++a)
+      for (int b = 0; b < nd; ++b) {
+        if (dofs[a] < 0 || dofs[b] < 0) continue;
+        const int* first = K0_.innerIndexPtr() + K0_.outerIndexPtr()[dofs[b]];
+        const int* last = K0_.innerIndexPtr() + K0_.outerIndexPtr()[dofs[b] + 1];
+        const int* it = std::lower_bound(first, last, dofs[a]);
+        if (it == last || *it != dofs[a]) throw InternalError("ParametricModel: DOF pair outside the pattern");
+        pos[static_cast<std::size_t>(a) * nd + b] = static_cast<int>(it - K0_.innerIndexPtr());
+      }
+    return pos;
+  };
+  // Factor parameters, grouped per element: each element part becomes one term with the parameters acting on it.
+  std::map<int, std::vector<int>> by_element;
+  for (int p = 0; p < num_parameters(); ++p)
+    for (int e : params_[p].elements) by_element[e].push_back(p);
+  for (const auto& [e, ps] : by_element) {
+    const ElementParts parts = model_.element_parts(e);
+    std::vector<int> dofs;
+    model_.element_dofs(e, &dofs);
+    const std::vector<int> pos = positions(dofs);
+    struct PartDef {
+      const Eigen::MatrixXd* m;
+      bool mass;
+      bool e, rho, a, i;  // which kinds act on it
+    };
+    const Eigen::MatrixXd Kbt = parts.K_bending + parts.K_torsion;
+    const PartDef defs[] = {{&parts.K_axial, false, true, false, true, false},
+                            {&Kbt, false, true, false, false, true},
+                            {&parts.M_translational, true, false, true, true, false},
+                            {&parts.M_rotary, true, false, true, false, true}};
+    for (const PartDef& d : defs) {
+      if (d.m->cwiseAbs().maxCoeff() == 0.0) continue;
+      Term t;
+      t.dofs = dofs;
+      t.A = *d.m;
+      t.pos = pos;
+      t.mass = d.mass;
+      for (int p : ps) {
+        const ParameterKind k = params_[p].kind;
+        const bool acts = (k == ParameterKind::kStiffness && d.e) || (k == ParameterKind::kMass && d.rho) ||
+                          (k == ParameterKind::kArea && d.a) || (k == ParameterKind::kInertia && d.i);
+        if (acts) t.params.push_back(p);
+      }
+      if (t.params.empty()) continue;  // this part is not parameterised: it stays in the fixed values
+      Eigen::VectorXd& fixed = t.mass ? Mfixed_ : Kfixed_;
+      const int nd = static_cast<int>(dofs.size());
+      for (int a = 0; a < nd; ++a)
+        for (int b = 0; b < nd; ++b) {
+          const int q = pos[static_cast<std::size_t>(a) * nd + b];
+          if (q >= 0) fixed[q] -= t.A(a, b);
+        }
+      terms_.push_back(std::move(t));
+    }
+  }
+  // Additive parameters: unit matrices on the node's DOFs, scaled by theta.
+  for (int p = 0; p < num_parameters(); ++p) {
+    const Parameter& q = params_[p];
+    if (q.kind != ParameterKind::kPointMass && q.kind != ParameterKind::kSpring) continue;
+    Term t;
+    for (int d = 0; d < kNumDofTypes; ++d)
+      if (q.dofs & (1u << d)) t.dofs.push_back(model_.dof_map().eq(q.node, static_cast<Dof>(d)));
+    t.A = Eigen::MatrixXd::Identity(static_cast<Eigen::Index>(t.dofs.size()), static_cast<Eigen::Index>(t.dofs.size()));
+    t.pos = positions(t.dofs);
+    t.mass = q.kind == ParameterKind::kPointMass;
+    t.params = {p};
+    t.additive = true;
+    terms_.push_back(std::move(t));
+  }
+  terms_of_param_.assign(params_.size(), {});
+  for (std::size_t k = 0; k < terms_.size(); ++k)
+    for (int p : terms_[k].params) terms_of_param_[p].push_back(static_cast<int>(k));
+  built_ = true;
+}
+
+double ParametricModel::scale(const Term& t, const Eigen::VectorXd& theta) const {
+  if (t.additive) return theta[t.params[0]];
+  double s = 1.0;
+  for (int p : t.params) s *= theta[p];
+  return s;
+}
+
+double ParametricModel::dscale(const Term& t, int p, const Eigen::VectorXd& theta) const {
+  if (t.additive) return 1.0;
+  double s = 1.0;
+  for (int q : t.params)
+    if (q != p) s *= theta[q];
+  return s;
+}
+
+void ParametricModel::matrices(const Eigen::VectorXd& theta, SparseMatrix* K, SparseMatrix* M) const {
+  if (theta.size() != num_parameters())
+    throw InputError("ParametricModel: " + std::to_string(theta.size()) + " values for " + std::to_string(num_parameters()) + " parameters");
+  build();
+  if (K) {
+    *K = K0_;
+    Eigen::Map<Eigen::VectorXd>(K->valuePtr(), K->nonZeros()) = Kfixed_;
+  }
+  if (M) {
+    *M = M0_;
+    Eigen::Map<Eigen::VectorXd>(M->valuePtr(), M->nonZeros()) = Mfixed_;
+  }
+  for (const Term& t : terms_) {
+    SparseMatrix* target = t.mass ? M : K;
+    if (!target) continue;
+    const double s = scale(t, theta);
+    double* v = target->valuePtr();
+    const int nd = static_cast<int>(t.dofs.size());
+    for (int a = 0; a < nd; ++a)
+      for (int b = 0; b < nd; ++b) {
+        const int q = t.pos[static_cast<std::size_t>(a) * nd + b];
+        if (q >= 0) v[q] += s * t.A(a, b);
+      }
+  }
+}
+
+Eigen::MatrixXd ParametricModel::eigenvalue_sensitivities(const Eigen::VectorXd& theta, const Eigen::VectorXd& lambda,
+                                                          const Eigen::MatrixXd& Phi) const {
+  build();
+  const Eigen::Index m = Phi.cols();
+  Eigen::MatrixXd S = Eigen::MatrixXd::Zero(m, num_parameters());
+  Eigen::VectorXd pe;
+  for (int p = 0; p < num_parameters(); ++p)
+    for (int k : terms_of_param_[p]) {
+      const Term& t = terms_[k];
+      const double ds = dscale(t, p, theta);
+      const int nd = static_cast<int>(t.dofs.size());
+      for (Eigen::Index i = 0; i < m; ++i) {
+        pe.setZero(nd);
+        for (int a = 0; a < nd; ++a)
+          if (t.dofs[a] >= 0) pe[a] = Phi(t.dofs[a], i);
+        const double q = pe.dot(t.A * pe) * ds;
+        S(i, p) += t.mass ? -lambda[i] * q : q;
+      }
+    }
+  return S;
+}
+
+void ParametricModel::derivative_products(int p, const Eigen::VectorXd& theta, const Eigen::VectorXd& v,
+                                          SparseProducts* out) const {
+  build();
+  out->dof.clear();
+  out->dKv.clear();
+  out->dMv.clear();
+  Eigen::VectorXd ve;
+  for (int k : terms_of_param_[p]) {
+    const Term& t = terms_[k];
+    const double ds = dscale(t, p, theta);
+    const int nd = static_cast<int>(t.dofs.size());
+    ve.setZero(nd);
+    for (int a = 0; a < nd; ++a)
+      if (t.dofs[a] >= 0) ve[a] = v[t.dofs[a]];
+    const Eigen::VectorXd y = ds * (t.A * ve);
+    for (int a = 0; a < nd; ++a) {
+      if (t.dofs[a] < 0) continue;
+      out->dof.push_back(t.dofs[a]);
+      out->dKv.push_back(t.mass ? 0.0 : y[a]);
+      out->dMv.push_back(t.mass ? y[a] : 0.0);
+    }
+  }
+}
+
+}  // namespace dynid
