@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <random>
 #include <sstream>
 
 #include "dynid/engine/sensitivity.hpp"
@@ -116,57 +117,35 @@ ModalData select_modes(const ModalData& d, const std::vector<int>& used) {
   return o;
 }
 
-// Mixed-precision refinement of eigenpairs of (K, M) and their residual forces against (K0, M0):
-// Newton on F(phi, lambda) = [(K - lambda M) phi; (1 - phi^T M phi)/2] with F evaluated in long double and the
-// bordered Jacobian [[K - lambda M, -M phi], [-phi^T M, 0]] solved in double (LU). Returns R = (-K0 + lambda M0)
-// phi formed in long double, phi scaled back to the given shape.
+// Residual forces R = (-K0 + lambda M0) phi of eigenpairs of (K, M) refined in extended precision
+// (refine_eigenpairs), formed in long double; phi scaled back to the given shapes, which the element fits use.
 Eigen::MatrixXd extended_residuals(const SparseMatrix& K, const SparseMatrix& M, const SparseMatrix& K0,
                                    const SparseMatrix& M0, const Eigen::VectorXd& lam_in, const Eigen::MatrixXd& Phi_in) {
   using LD = long double;
   const int n = static_cast<int>(K.rows());
-  const Eigen::MatrixXd Kd(K), Md(M);
-  auto spmv = [&](const SparseMatrix& A, const std::vector<LD>& x, std::vector<LD>* y) {
-    y->assign(n, 0.0L);
-    for (int j = 0; j < n; ++j)
-      for (SparseMatrix::InnerIterator it(A, j); it; ++it) (*y)[it.row()] += static_cast<LD>(it.value()) * x[j];
-  };
-  Eigen::MatrixXd R(n, Phi_in.cols());
-  std::vector<LD> phi(n), kp, mp;
-  for (Eigen::Index i = 0; i < Phi_in.cols(); ++i) {
-    LD lam = lam_in[i];
-    const double nrm = std::sqrt(Phi_in.col(i).dot(Md * Phi_in.col(i)));
-    for (int k = 0; k < n; ++k) phi[k] = Phi_in(k, i) / nrm;
-    for (int it = 0; it < 4; ++it) {
-      spmv(K, phi, &kp);
-      spmv(M, phi, &mp);
-      Eigen::VectorXd rhs(n + 1), ph(n), mph(n);
-      LD nn = 0;
-      for (int k = 0; k < n; ++k) {
-        rhs[k] = -static_cast<double>(kp[k] - lam * mp[k]);
-        nn += phi[k] * mp[k];
-        ph[k] = static_cast<double>(phi[k]);
-        mph[k] = static_cast<double>(mp[k]);
-      }
-      rhs[n] = -static_cast<double>((1.0L - nn) / 2.0L);
-      Eigen::MatrixXd J(n + 1, n + 1);
-      J.topLeftCorner(n, n) = Kd - static_cast<double>(lam) * Md;
-      J.topRightCorner(n, 1) = -mph;
-      J.bottomLeftCorner(1, n) = -mph.transpose();
-      J(n, n) = 0;
-      const Eigen::VectorXd d = J.partialPivLu().solve(rhs);
-      for (int k = 0; k < n; ++k) phi[k] += d[k];
-      lam += d[n];
-    }
-    // Back to the scale (and sign) of the given shape, which the element fits use.
+  Eigen::VectorXd lam = lam_in;
+  Eigen::MatrixXd Phi = Phi_in;
+  const Eigen::MatrixXd Md(M);
+  for (Eigen::Index i = 0; i < Phi.cols(); ++i) Phi.col(i) /= std::sqrt(Phi.col(i).dot(Md * Phi.col(i)));
+  std::vector<LD> ext;
+  refine_eigenpairs(K, M, &lam, &Phi, &ext, 4);
+  Eigen::MatrixXd R(n, Phi.cols());
+  std::vector<LD> kp, mp;
+  for (Eigen::Index i = 0; i < Phi.cols(); ++i) {
+    const LD* phi = ext.data() + static_cast<std::size_t>(i) * n;
     LD num = 0, den = 0;
     for (int k = 0; k < n; ++k) {
       num += static_cast<LD>(Phi_in(k, i)) * phi[k];
       den += phi[k] * phi[k];
     }
-    for (int k = 0; k < n; ++k) phi[k] *= num / den;
-    spmv(K0, phi, &kp);
-    spmv(M0, phi, &mp);
-    for (int k = 0; k < n; ++k) R(k, i) = static_cast<double>(-kp[k] + lam * mp[k]);
+    const LD scale = num / den;
+    kp.assign(n, 0.0L);
+    mp.assign(n, 0.0L);
+    for (int j = 0; j < n; ++j) {
+      for (SparseMatrix::InnerIterator it(K0, j); it; ++it) kp[it.row()] += static_cast<LD>(it.value()) * phi[j];
+      for (SparseMatrix::InnerIterator it(M0, j); it; ++it) mp[it.row()] += static_cast<LD>(it.value()) * phi[j];
+    }
+    for (int k = 0; k < n; ++k) R(k, i) = static_cast<double>(scale * (-kp[k] + static_cast<LD>(lam[i]) * mp[k]));
   }
   return R;
 }
@@ -625,6 +604,62 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
     }
   }
   return S;
+}
+
+}  // namespace dynid
+
+namespace dynid {
+
+std::vector<NoiseStudyRow> noise_study(const Model& reference, const Model& changed, int element_id,
+                                       const NoiseStudyOptions& o) {
+  if (o.trials < 1) throw InputError("noise study: trials must be >= 1");
+  if (o.dofs.empty()) throw InputError("noise study: no measured DOFs");
+  const int e = reference.element_index(element_id);
+  if (e < 0) throw InputError("noise study: element " + std::to_string(element_id) + " does not exist");
+  EigenOptions eo;
+  const int nrb = changed.free_free() ? static_cast<int>(changed.free_rigid_body_modes().cols()) : 0;
+  eo.num_modes = nrb + o.modes;
+  const ModalResult r = modal_analysis(changed, eo);
+  if (!r.ok()) throw NumericalError("noise study: modal analysis of the changed model failed: " + r.summary.message);
+  const ModalData exact = sample_modes(changed, r, o.dofs, nrb, o.modes, "noise study");
+  const std::vector<Symmetry> syms = find_symmetries(reference);
+  const std::vector<int> twins = element_twins(syms, e);
+  std::vector<int> twin_ids;
+  for (int t : twins) twin_ids.push_back(reference.elements()[t].id);
+  std::vector<NoiseStudyRow> rows;
+  for (double sn : o.shape_noise) {
+    NoiseStudyRow row;
+    row.shape_noise = sn;
+    row.trials = o.trials;
+    std::mt19937_64 rng(o.seed);
+    std::normal_distribution<double> N(0.0, 1.0);
+    DetectOptions d;
+    d.frequency_noise = o.frequency_noise;
+    d.shape_noise = sn;
+    d.localize_only = true;
+    for (int t = 0; t < o.trials; ++t) {
+      ModalData m = exact;
+      for (Eigen::Index k = 0; k < m.shapes.cols(); ++k) {
+        m.frequencies_hz[k] *= 1.0 + o.frequency_noise * N(rng);
+        const double big = m.shapes.col(k).cwiseAbs().maxCoeff();
+        for (Eigen::Index i = 0; i < m.shapes.rows(); ++i) m.shapes(i, k) += sn * big * N(rng);
+      }
+      const DetectSummary s = detect(reference, m, d);
+      for (const ElementScore& es : s.elements) {
+        if (es.element == element_id) {
+          row.pseudo_first += es.pseudo_rank == 1;
+          row.pseudo_top3 += es.pseudo_rank <= 3;
+          row.dynid_first += es.rank == 1;
+          row.dynid_top3 += es.rank <= 3;
+          for (int tid : twin_ids)
+            if (std::find(es.twins.begin(), es.twins.end(), tid) != es.twins.end()) ++row.twin_called;
+        }
+        if (es.rank == 1 && std::find(twin_ids.begin(), twin_ids.end(), es.element) != twin_ids.end()) ++row.twin_first;
+      }
+    }
+    rows.push_back(row);
+  }
+  return rows;
 }
 
 }  // namespace dynid

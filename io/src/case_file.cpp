@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "dynid/engine/modal.hpp"
+#include "dynid/io/modal_data_io.hpp"
 #include "internal/model_yaml.hpp"
 
 namespace dynid {
@@ -53,6 +54,159 @@ AnalysisSpec parse_analysis(const YAML::Node& n, const YamlCtx& ctx) {
   return a;
 }
 
+// measured_dofs: all | translations | {types: [ux, uy], nodes: [...]} | [13ux, 13uy, ...]
+std::vector<MeasuredDof> parse_dof_selection(const YAML::Node& n, const YamlCtx& ctx, const Model& model,
+                                             const std::string& what) {
+  std::vector<MeasuredDof> out;
+  if (n.IsScalar()) {
+    const std::string v = n.Scalar();
+    if (v == "all") return all_dofs(model);
+    if (v == "translations") return dofs_of_types(model, kTranslations);
+    ctx.fail(n, what + ": expected all, translations, {types: [...], nodes: [...]} or a list of DOF labels like 13ux");
+  }
+  if (n.IsMap()) {
+    ctx.only_keys(n, what, {"types", "nodes"});
+    DofMask types = 0;
+    if (!n["types"]) ctx.fail(n, what + ": types is missing (e.g. types: [ux, uy])");
+    ctx.require_sequence(n["types"], what + " types");
+    for (const auto& t : n["types"]) {
+      Dof d;
+      if (!parse_dof(ctx.string(t, what + " type"), &d)) ctx.fail(t, what + ": unknown DOF type '" + t.Scalar() + "'");
+      types |= dof_bit(d);
+    }
+    std::vector<int> nodes;
+    if (n["nodes"]) {
+      ctx.require_sequence(n["nodes"], what + " nodes");
+      for (const auto& q : n["nodes"]) {
+        const int id = ctx.integer(q, what + " node");
+        if (model.node_index(id) < 0) ctx.fail(q, what + ": node " + std::to_string(id) + " does not exist");
+        nodes.push_back(id);
+      }
+    }
+    out = dofs_of_types(model, types, nodes);
+    if (out.empty()) ctx.fail(n, what + ": selects no free DOF of the model");
+    return out;
+  }
+  ctx.require_sequence(n, what);
+  for (const auto& q : n) {
+    MeasuredDof d;
+    const std::string lab = ctx.string(q, what + " DOF");
+    if (!parse_dof_label(lab, &d)) ctx.fail(q, what + ": '" + lab + "' is not a DOF label (e.g. 13ux)");
+    out.push_back(d);
+  }
+  try {
+    measured_equations(model, out);
+  } catch (const InputError& e) {
+    ctx.fail(n, what + ": " + e.what());
+  }
+  return out;
+}
+
+void parse_noise(const YAML::Node& n, const YamlCtx& ctx, DetectOptions* o) {
+  ctx.require_map(n, "noise");
+  ctx.only_keys(n, "noise", {"frequency", "shape"});
+  if (n["frequency"]) o->frequency_noise = ctx.number(n["frequency"], "noise frequency");
+  if (n["shape"]) o->shape_noise = ctx.number(n["shape"], "noise shape");
+  if (!(o->frequency_noise > 0) || !(o->shape_noise > 0)) ctx.fail(n, "noise: frequency and shape must be > 0 (relative std)");
+}
+
+std::string resolve(const std::string& dir, const std::string& file) {
+  const fs::path p(file);
+  return p.is_absolute() ? file : (fs::path(dir) / p).lexically_normal().string();
+}
+
+DetectSpec parse_detect(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir) {
+  ctx.require_map(n, "detect");
+  ctx.only_keys(n, "detect", {"modes", "changed", "measured", "reference_measured", "measured_dofs", "noise",
+                              "significance", "max_changed", "refine", "serep_modes", "min_mac", "candidates", "study"});
+  DetectSpec d;
+  DetectOptions& o = d.options;
+  if (n["modes"]) {
+    o.modes = ctx.integer(n["modes"], "detect modes");
+    if (o.modes < 1) ctx.fail(n["modes"], "detect: modes must be >= 1");
+  }
+  if (n["changed"] && n["measured"]) ctx.fail(n, "detect: give either changed: (a simulation) or measured: (a file), not both");
+  if (!n["changed"] && !n["measured"]) ctx.fail(n, "detect: the changed state is missing: give changed: {elements: [...]} or measured: FILE");
+  if (n["changed"]) {
+    const YAML::Node& c = n["changed"];
+    ctx.require_map(c, "changed");
+    ctx.only_keys(c, "changed", {"elements"});
+    ctx.require_sequence(c["elements"], "changed elements");
+    for (const auto& e : c["elements"]) {
+      ctx.require_map(e, "changed element");
+      ctx.only_keys(e, "changed element", {"id", "dk", "dm"});
+      const int id = ctx.integer(e["id"], "changed element id");
+      if (model.element_index(id) < 0) ctx.fail(e["id"], "changed element " + std::to_string(id) + " does not exist");
+      const double dk = e["dk"] ? ctx.number(e["dk"], "dk") : 0.0, dm = e["dm"] ? ctx.number(e["dm"], "dm") : 0.0;
+      if (!(dk > -1 && dm > -1)) ctx.fail(e, "changed element: dk and dm must be > -1 (fractions: -0.15 = 15 % loss)");
+      d.changes.push_back({id, {dk, dm}});
+    }
+    d.measured_dofs = n["measured_dofs"] ? parse_dof_selection(n["measured_dofs"], ctx, model, "measured_dofs") : all_dofs(model);
+  } else {
+    d.measured_file = resolve(dir, ctx.string(n["measured"], "measured"));
+    if (n["measured_dofs"]) ctx.fail(n["measured_dofs"], "detect: measured_dofs is for simulations; measured data carry their own DOFs");
+  }
+  if (n["reference_measured"]) d.reference_measured_file = resolve(dir, ctx.string(n["reference_measured"], "reference_measured"));
+  if (n["noise"]) parse_noise(n["noise"], ctx, &o);
+  if (n["significance"]) o.significance = ctx.number(n["significance"], "significance");
+  if (!(o.significance > 0 && o.significance < 1)) ctx.fail(n["significance"], "detect: significance must be in (0, 1)");
+  if (n["max_changed"]) o.max_changed = ctx.integer(n["max_changed"], "max_changed");
+  if (o.max_changed < 1) ctx.fail(n["max_changed"], "detect: max_changed must be >= 1");
+  if (n["refine"]) o.refine = ctx.boolean(n["refine"], "refine");
+  if (n["serep_modes"]) o.serep_modes = ctx.integer(n["serep_modes"], "serep_modes");
+  if (n["min_mac"]) o.min_mac = ctx.number(n["min_mac"], "min_mac");
+  if (n["candidates"]) {
+    ctx.require_sequence(n["candidates"], "candidates");
+    for (const auto& q : n["candidates"]) {
+      const int id = ctx.integer(q, "candidate");
+      if (model.element_index(id) < 0) ctx.fail(q, "candidate element " + std::to_string(id) + " does not exist");
+      o.candidates.push_back(id);
+    }
+  }
+  if (n["study"]) {
+    const YAML::Node& st = n["study"];
+    ctx.require_map(st, "study");
+    ctx.only_keys(st, "study", {"trials", "modes", "frequency_noise", "shape_noise", "seed", "measured_dofs"});
+    d.has_study = true;
+    NoiseStudyOptions& so = d.study;
+    if (d.changes.size() != 1) ctx.fail(st, "study: a noise study needs exactly one changed element in changed:");
+    if (st["trials"]) so.trials = ctx.integer(st["trials"], "study trials");
+    if (so.trials < 1) ctx.fail(st["trials"], "study: trials must be >= 1");
+    if (st["modes"]) so.modes = ctx.integer(st["modes"], "study modes");
+    if (st["frequency_noise"]) so.frequency_noise = ctx.number(st["frequency_noise"], "study frequency_noise");
+    if (st["shape_noise"]) so.shape_noise = ctx.numbers(st["shape_noise"], "study shape_noise");
+    if (st["seed"]) so.seed = static_cast<std::uint64_t>(ctx.integer(st["seed"], "study seed"));
+    so.dofs = st["measured_dofs"] ? parse_dof_selection(st["measured_dofs"], ctx, model, "study measured_dofs") : d.measured_dofs;
+  }
+  return d;
+}
+
+// model: {include: other.yaml} takes the model section of another case file (path relative to this one).
+YAML::Node model_node(const YAML::Node& root, YamlCtx* ctx, std::string* dir, int depth) {
+  YAML::Node m = root["model"];
+  if (!m.IsMap() || !m["include"]) return m;
+  if (m.size() != 1) ctx->fail(m, "model: include cannot be combined with other model keys");
+  if (depth > 8) ctx->fail(m, "model: include nested too deep (a cycle?)");
+  const std::string file = resolve(*dir, ctx->string(m["include"], "model include"));
+  std::error_code ec;
+  const std::string path = resolve_case_path(file);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) ctx->fail(m["include"], "model include: cannot open '" + file + "'");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  YAML::Node inc;
+  try {
+    inc = YAML::Load(ss.str());
+  } catch (const YAML::ParserException& e) {
+    throw InputError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+                     ": malformed case file: " + e.msg);
+  }
+  if (!inc.IsMap() || !inc["model"]) ctx->fail(m["include"], "model include: '" + path + "' has no model: section");
+  ctx->file = path;
+  *dir = fs::path(path).parent_path().string();
+  return model_node(inc, ctx, dir, depth + 1);
+}
+
 }  // namespace
 
 std::string resolve_case_path(const std::string& path) {
@@ -79,15 +233,21 @@ Case parse_case(const std::string& text, const std::string& name, const std::str
   }
   if (!root || root.IsNull()) throw InputError(name + ": the case file is empty");
   ctx.require_map(root, "case file");
-  ctx.only_keys(root, "the case file", {"name", "description", "model", "analysis"});
+  ctx.only_keys(root, "the case file", {"name", "description", "model", "analysis", "detect"});
   Case c;
   c.path = name;
   c.dir = dir;
   c.name = root["name"] ? ctx.string(root["name"], "name") : fs::path(dir).filename().string();
   if (root["description"]) c.description = ctx.string(root["description"], "description");
   if (!root["model"]) ctx.fail(root, "the case has no model: section");
-  c.model = internal::parse_model(root["model"], ctx);
+  {
+    YamlCtx mctx = ctx;
+    std::string mdir = dir;
+    const YAML::Node m = model_node(root, &mctx, &mdir, 0);
+    c.model = internal::parse_model(m, mctx);
+  }
   c.analysis = parse_analysis(root["analysis"], ctx);
+  if (root["detect"]) c.detect = parse_detect(root["detect"], ctx, c.model, dir);
   return c;
 }
 

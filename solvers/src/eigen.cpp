@@ -245,6 +245,73 @@ std::string EigenSummary::FullReport() const {
   return s.str();
 }
 
+void refine_eigenpairs(const SparseMatrix& K, const SparseMatrix& M, Eigen::VectorXd* lambda, Eigen::MatrixXd* Phi,
+                       std::vector<long double>* phi_extended, int iterations) {
+  using LD = long double;
+  const int n = static_cast<int>(K.rows());
+  if (Phi->rows() != n || Phi->cols() != lambda->size()) throw InputError("refine_eigenpairs: sizes do not match");
+  if (n > 5000) throw InputError("refine_eigenpairs: dense refinement is limited to 5000 DOFs");
+  const Eigen::MatrixXd Kd(K), Md(M);
+  auto spmv = [&](const SparseMatrix& A, const std::vector<LD>& x, std::vector<LD>* y) {
+    y->assign(n, 0.0L);
+    for (int j = 0; j < n; ++j)
+      for (SparseMatrix::InnerIterator it(A, j); it; ++it) (*y)[it.row()] += static_cast<LD>(it.value()) * x[j];
+  };
+  if (phi_extended) phi_extended->assign(static_cast<std::size_t>(n) * Phi->cols(), 0.0L);
+  std::vector<LD> phi(n), kp, mp;
+  const double lmax = lambda->size() ? lambda->cwiseAbs().maxCoeff() : 0.0;
+  auto residual = [&](const std::vector<LD>& x, LD l) {
+    spmv(K, x, &kp);
+    spmv(M, x, &mp);
+    LD r = 0;
+    for (int k = 0; k < n; ++k) r += (kp[k] - l * mp[k]) * (kp[k] - l * mp[k]);
+    return std::sqrt(r);
+  };
+  for (Eigen::Index i = 0; i < Phi->cols(); ++i) {
+    LD lam = (*lambda)[i];
+    for (int k = 0; k < n; ++k) phi[k] = (*Phi)(k, i);
+    // A repeated eigenvalue (e.g. the rigid-body modes) makes the bordered Jacobian singular: left as it is.
+    bool repeated = false;
+    for (Eigen::Index j = 0; j < Phi->cols(); ++j)
+      if (j != i && std::abs((*lambda)[j] - (*lambda)[i]) <=
+                        1e-6 * std::max(std::abs((*lambda)[i]), std::abs((*lambda)[j])) + 1e-12 * lmax)
+        repeated = true;
+    const LD r0 = residual(phi, lam);
+    const std::vector<LD> phi0 = phi;
+    const LD lam0 = lam;
+    for (int it = 0; it < iterations && !repeated; ++it) {
+      spmv(K, phi, &kp);
+      spmv(M, phi, &mp);
+      Eigen::VectorXd rhs(n + 1), mph(n);
+      LD nn = 0;
+      for (int k = 0; k < n; ++k) {
+        rhs[k] = -static_cast<double>(kp[k] - lam * mp[k]);
+        nn += phi[k] * mp[k];
+        mph[k] = static_cast<double>(mp[k]);
+      }
+      rhs[n] = -static_cast<double>((1.0L - nn) / 2.0L);
+      Eigen::MatrixXd J(n + 1, n + 1);
+      J.topLeftCorner(n, n) = Kd - static_cast<double>(lam) * Md;
+      J.topRightCorner(n, 1) = -mph;
+      J.bottomLeftCorner(1, n) = -mph.transpose();
+      J(n, n) = 0;
+      const Eigen::VectorXd d = J.partialPivLu().solve(rhs);
+      if (!d.allFinite()) break;  // singular bordered matrix (repeated eigenvalue): keep what we have
+      for (int k = 0; k < n; ++k) phi[k] += d[k];
+      lam += d[n];
+    }
+    if (!(residual(phi, lam) <= r0)) {  // refinement did not help (ill-conditioned): keep the input
+      phi = phi0;
+      lam = lam0;
+    }
+    (*lambda)[i] = static_cast<double>(lam);
+    for (int k = 0; k < n; ++k) {
+      (*Phi)(k, i) = static_cast<double>(phi[k]);
+      if (phi_extended) (*phi_extended)[static_cast<std::size_t>(i) * n + k] = phi[k];
+    }
+  }
+}
+
 double eigen_residual(const SparseMatrix& K, const SparseMatrix& M, double lambda, const Eigen::VectorXd& phi) {
   const Eigen::Index n = phi.size();
   Eigen::VectorXd kp(n), mp(n);
@@ -600,8 +667,10 @@ EigenSolution solve_eigen_dense(const Eigen::MatrixXd& K, const Eigen::MatrixXd&
       sum.message = "dense generalized eigen-solver did not converge";
       return sol;
     }
-    lam = es.eigenvalues();
     V = es.eigenvectors();
+    // Rayleigh quotients: accurate relative to each eigenvalue, while the eigen-decomposition of
+    // L^{-1} K L^{-T} is accurate only to ~eps * lambda_max in absolute terms (frames: lambda_max / lambda_1 ~ 1e8).
+    lam = (V.transpose() * Ks * V).diagonal().cwiseQuotient((V.transpose() * Ms * V).diagonal());
   } else {
     // Singular (or nearly singular) M: with A = K - sigma M = L L^T positive definite (sigma < 0), the pencil
     // becomes the standard problem C y = theta y, C = L^{-1} M L^{-T}, theta = 1 / (lambda - sigma);

@@ -5,6 +5,9 @@
 #include <limits>
 #include <string>
 
+#include <optional>
+
+#include "dynid/engine/detect.hpp"
 #include "dynid/mesh/model.hpp"
 #include "dynid/solvers/eigen.hpp"
 
@@ -20,12 +23,25 @@ struct AnalysisSpec {
   EigenOptions eigen_options() const;  ///< the solver options this spec means
 };
 
+/// What `detect:` asks for (docs/case-file.md): the changed state is either simulated (the reference model with
+/// element changes, its exact modes taken at `measured_dofs`) or measured modal data from a file.
+struct DetectSpec {
+  std::vector<std::pair<int, std::pair<double, double>>> changes;  ///< element id -> (dk, dm)
+  std::string measured_file;            ///< changed-state modal data (JSON) instead of `changes`
+  std::string reference_measured_file;  ///< optional reference-state modal data
+  std::vector<MeasuredDof> measured_dofs;  ///< DOFs the simulated changed state is "measured" at
+  DetectOptions options;
+  bool has_study = false;
+  NoiseStudyOptions study;
+};
+
 struct Case {
   std::string path;         ///< the case file
   std::string dir;          ///< its folder (relative paths in the case resolve against it)
   std::string name, description;
   Model model;              ///< finalized
   AnalysisSpec analysis;
+  std::optional<DetectSpec> detect;
 };
 
 /// Loads a case from a case file, or from a folder holding case.yaml / case.yml / case.json.

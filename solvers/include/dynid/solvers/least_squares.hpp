@@ -7,7 +7,8 @@
 namespace dynid {
 
 struct LeastSquaresResult {
-  Eigen::VectorXd x;                ///< minimum-norm least-squares solution of min ||A x - b||
+  Eigen::VectorXd x;                ///< least-squares solution of min ||A x - b||; if A is rank-deficient, the one
+                                    ///< of minimum norm in the column-scaled variables x_j ||A_j||
   int rank = 0;                     ///< numerical rank: singular values > rcond * sigma_max
   double condition = 0;             ///< sigma_max / sigma_min over all singular values (inf if rank-deficient)
   Eigen::VectorXd singular_values;  ///< descending

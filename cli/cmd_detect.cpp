@@ -1,0 +1,227 @@
+// dynid detect CASE [--json FILE] [--plot FILE] [--study]: locate and quantify changes by residual forces.
+#include <fmt/core.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "commands.hpp"
+#include "dynid/engine/detect.hpp"
+#include "dynid/io/case_file.hpp"
+#include "dynid/io/modal_data_io.hpp"
+#include "dynid/io/output.hpp"
+#include "dynid/io/plot.hpp"
+#include "dynid/mesh/error.hpp"
+#include "progress.hpp"
+
+namespace dynid::cli {
+
+namespace {
+
+struct DetectArgs {
+  std::string case_path, json, plot;
+  bool study = false, force = false;
+};
+
+nlohmann::json summary_json(const Case& c, const Model& model, const DetectSummary& S) {
+  nlohmann::json j;
+  j["case"] = c.name;
+  j["method"] = S.method;
+  j["threshold_rule"] = S.threshold_rule;
+  j["full_dofs"] = S.full_dofs;
+  j["modes"] = {{"used", S.used_modes},
+                {"model_hz", std::vector<double>(S.model_hz.data(), S.model_hz.data() + S.model_hz.size())},
+                {"changed_hz", std::vector<double>(S.changed_hz.data(), S.changed_hz.data() + S.changed_hz.size())},
+                {"mac", std::vector<double>(S.mac.data(), S.mac.data() + S.mac.size())}};
+  nlohmann::json els = nlohmann::json::array();
+  for (const ElementScore& e : S.elements) {
+    nlohmann::json x = {{"id", e.element},       {"score", S.full_dofs ? e.probability : e.probability},
+                        {"flagged", e.flagged},  {"rank", e.rank},
+                        {"pseudo", std::isnan(e.pseudo) ? nlohmann::json() : nlohmann::json(e.pseudo)},
+                        {"pseudo_rank", e.pseudo_rank}, {"chi2", e.chi2}, {"twins", e.twins}};
+    els.push_back(x);
+  }
+  nlohmann::json dofs = nlohmann::json::array();
+  for (std::size_t r = 0; r < S.dofs.size(); ++r)
+    dofs.push_back({{"dof", to_string(S.dofs[r])}, {"pseudo", S.pseudo[r]}, {"reference", S.pseudo_reference[r]},
+                    {"delta", S.delta_pseudo[r]}});
+  j["localization"] = {{"elements", els},
+                       {"dofs", dofs},
+                       {"score", S.full_dofs ? "fraction of the residual-force energy the element alone explains"
+                                             : "posterior probability that this element alone changed"},
+                       {"chi2_unchanged", S.chi2_unchanged},
+                       {"chi2_final", S.chi2_final}};
+  nlohmann::json q = nlohmann::json::array();
+  auto num = [](double v) { return std::isnan(v) ? nlohmann::json() : nlohmann::json(v); };
+  for (const ElementAmount& a : S.amounts)
+    q.push_back({{"element", a.element}, {"dk", a.dk}, {"dm", a.dm}, {"dk_first_order", a.dk_first_order},
+                 {"dm_first_order", a.dm_first_order}, {"dk_std", num(a.dk_std)}, {"dm_std", num(a.dm_std)}});
+  j["quantification"] = q;
+  j["first_order_condition"] = S.first_order_condition;
+  j["serep"] = {{"modes", S.serep_modes}, {"rank", S.serep_rank}};
+  j["warnings"] = S.warnings;
+  (void)model;
+  return j;
+}
+
+plot::Figure summary_figure(const Case& c, const Model& model, const DetectSummary& S) {
+  plot::Figure f;
+  f.title = "dynid detect: " + c.name;
+  f.rows = 3;
+  f.height = 1300;
+  // Per DOF: the pseudo residual force (log), DOFs of flagged elements highlighted.
+  std::vector<int> flagged_nodes;
+  for (const ElementScore& e : S.elements)
+    if (e.flagged) {
+      const auto& en = model.element_nodes(model.element_index(e.element));
+      for (int q = 0; q < model.elements()[model.element_index(e.element)].num_nodes; ++q)
+        flagged_nodes.push_back(model.nodes()[en[q]].id);
+    }
+  plot::Panel p1;
+  p1.title = S.full_dofs ? "Pseudo residual force per DOF (eq. 7-8), all DOFs" : "Pseudo residual force per measured DOF (SEREP-reduced model)";
+  p1.ylabel = "|r| (geometric mean over modes)";
+  p1.log_y = true;
+  plot::Series in, out;
+  in.label = "DOFs of flagged elements";
+  out.label = "other DOFs";
+  in.kind = out.kind = plot::Kind::kStems;
+  in.color = 3;
+  out.color = 0;
+  for (std::size_t r = 0; r < S.dofs.size(); ++r) {
+    const bool hit = std::find(flagged_nodes.begin(), flagged_nodes.end(), S.dofs[r].node) != flagged_nodes.end();
+    plot::Series& s = hit ? in : out;
+    s.x.push_back(static_cast<double>(r + 1));
+    s.y.push_back(S.delta_pseudo[r]);
+    p1.xticks.push_back({static_cast<double>(r + 1), to_string(S.dofs[r])});
+  }
+  p1.series = {out, in};
+  // Per element: the paper's mapping (log) and dynid's localization.
+  plot::Panel p2, p3;
+  p2.title = "Pseudo residual force mapped to elements (paper)";
+  p2.ylabel = "element score";
+  p2.log_y = true;
+  p3.title = S.full_dofs ? "dynid: share of the residual force each element explains alone" : "dynid: probability that the element alone changed";
+  p3.ylabel = S.full_dofs ? "explained fraction" : "probability";
+  p3.xlabel = "element id";
+  plot::Series a2, b2, a3, b3;
+  a2.kind = b2.kind = a3.kind = b3.kind = plot::Kind::kBars;
+  a2.color = a3.color = 0;
+  b2.color = b3.color = 3;
+  b2.label = b3.label = "flagged";
+  for (const ElementScore& e : S.elements) {
+    (e.flagged ? b2 : a2).x.push_back(e.element);
+    (e.flagged ? b2 : a2).y.push_back(std::isnan(e.pseudo) ? 0.0 : e.pseudo);
+    (e.flagged ? b3 : a3).x.push_back(e.element);
+    (e.flagged ? b3 : a3).y.push_back(e.probability);
+  }
+  p2.series = {a2, b2};
+  p3.series = {a3, b3};
+  f.panels = {p1, p2, p3};
+  return f;
+}
+
+int run_detect(const DetectArgs& a, const GlobalOptions& g) {
+  set_threads(g.threads);
+  const Case c = load_case(a.case_path);
+  if (!c.detect) throw InputError(c.path + ": the case has no detect: section (see docs/case-file.md)");
+  const DetectSpec& d = *c.detect;
+  const Model& model = c.model;
+  Progress progress(!g.quiet);
+
+  if (a.study) {
+    if (!d.has_study) throw InputError(c.path + ": --study needs a study: section under detect:");
+    const Model changed = changed_model(model, d.changes);
+    progress.update("noise study", -1);
+    const auto rows = noise_study(model, changed, d.changes[0].first, d.study);
+    progress.done();
+    const int id = d.changes[0].first;
+    fmt::print("dynid detect --study: {} (element {}, dk {:+.1f} %, dm {:+.1f} %), {} trials per level, {} modes at {} DOFs, "
+               "frequency noise {:.2g} %, seed {}\n",
+               c.name, id, 100 * d.changes[0].second.first, 100 * d.changes[0].second.second, d.study.trials,
+               d.study.modes, d.study.dofs.size(), 100 * d.study.frequency_noise, d.study.seed);
+    fmt::print("| shape noise | paper pseudo residual: 1st | top 3 | dynid: 1st | top 3 | twin ranked 1st | twin called |\n"
+               "|---|---|---|---|---|---|---|\n");
+    nlohmann::json out = nlohmann::json::array();
+    for (const auto& r : rows) {
+      auto pct = [&](int k) { return 100.0 * k / r.trials; };
+      fmt::print("| {:.0f} % | {:.1f} % | {:.1f} % | {:.1f} % | {:.1f} % | {:.1f} % | {:.1f} % |\n", 100 * r.shape_noise,
+                 pct(r.pseudo_first), pct(r.pseudo_top3), pct(r.dynid_first), pct(r.dynid_top3), pct(r.twin_first),
+                 pct(r.twin_called));
+      out.push_back({{"shape_noise", r.shape_noise}, {"trials", r.trials}, {"pseudo_first", r.pseudo_first},
+                     {"pseudo_top3", r.pseudo_top3}, {"dynid_first", r.dynid_first}, {"dynid_top3", r.dynid_top3},
+                     {"twin_first", r.twin_first}, {"twin_called", r.twin_called}});
+    }
+    if (!a.json.empty()) write_file_atomic(a.json, nlohmann::json{{"case", c.name}, {"element", id}, {"study", out}}.dump(1) + "\n", a.force);
+    return 0;
+  }
+
+  // The changed state: a simulation of the modified model, or measured data.
+  ModalData changed;
+  Model changed_m;
+  DetectOptions opt = d.options;
+  if (!d.changes.empty()) {
+    changed_m = changed_model(model, d.changes);
+    EigenOptions eo;
+    const int nrb = changed_m.free_free() ? static_cast<int>(changed_m.free_rigid_body_modes().cols()) : 0;
+    const int p = opt.modes > 0 ? opt.modes : 6;
+    eo.num_modes = nrb + p;
+    progress.update("changed modes", -1);
+    const ModalResult r = modal_analysis(changed_m, eo);
+    if (!r.ok()) throw NumericalError("modal analysis of the changed model failed: " + r.summary.message);
+    changed = sample_modes(changed_m, r, d.measured_dofs, nrb, p, "simulation of " + c.name);
+    opt.simulated_changed = &changed_m;
+  } else {
+    changed = read_modal_data(d.measured_file);
+  }
+  ModalData refmeas;
+  if (!d.reference_measured_file.empty()) refmeas = read_modal_data(d.reference_measured_file);
+  progress.update("detect", -1);
+  const DetectSummary S = detect(model, changed, opt, d.reference_measured_file.empty() ? nullptr : &refmeas);
+  progress.done();
+
+  if (!g.quiet) {
+    fmt::print("dynid detect: {} ({} modes, {} DOFs{})\n", c.name, S.used_modes.size(), S.dofs.size(),
+               S.full_dofs ? ", every model DOF" : ", SEREP-reduced");
+    fmt::print("  localization: {}\n  rule: {}\n", S.method, S.threshold_rule);
+    fmt::print("  rank  element  score       pseudo(paper)  flagged\n");
+    for (std::size_t k = 0; k < S.elements.size() && k < 8; ++k) {
+      const ElementScore& e = S.elements[k];
+      std::string tw;
+      for (int t : e.twins) tw += (tw.empty() ? " twin of " : ", ") + std::to_string(t);
+      fmt::print("  {:4d}  {:7d}  {:<10.4g}  {:<13.4g}  {}{}\n", e.rank, e.element, e.probability, e.pseudo,
+                 e.flagged ? "yes" : "", tw);
+    }
+    if (!S.amounts.empty()) {
+      fmt::print("  quantification (fractions; -0.15 = 15 % loss):\n  element  dk          dm          dk 1st order  dm 1st order\n");
+      for (const ElementAmount& am : S.amounts)
+        fmt::print("  {:7d}  {:<+10.5f}  {:<+10.5f}  {:<+12.5f}  {:<+12.5f}\n", am.element, am.dk, am.dm,
+                   am.dk_first_order, am.dm_first_order);
+    } else {
+      fmt::print("  no element flagged\n");
+    }
+    for (const std::string& w : S.warnings) fmt::print(stderr, "dynid detect: warning: {}\n", w);
+  }
+  if (!a.json.empty()) {
+    write_file_atomic(a.json, summary_json(c, model, S).dump(1) + "\n", a.force);
+    const std::string png = a.plot.empty() ? std::filesystem::path(a.json).replace_extension(".png").string() : a.plot;
+    plot::save(summary_figure(c, model, S), png, a.force);
+  } else if (!a.plot.empty()) {
+    plot::save(summary_figure(c, model, S), a.plot, a.force);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void register_detect(CLI::App& app, GlobalOptions& g) {
+  auto a = std::make_shared<DetectArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "detect", "Locate and quantify changes (damage, added mass) by residual forces (the paper's NDT method)");
+  cmd->add_option("CASE", a->case_path, "Case file or folder with a detect: section")->required();
+  cmd->add_option("--json", a->json, "Write the results as JSON to FILE (and the plot beside it, FILE.png)");
+  cmd->add_option("--plot", a->plot, "Write the plot (pseudo residual per DOF and per element) to FILE (.png or .svg)");
+  cmd->add_flag("--study", a->study, "Run the case's noise study (detect: study:) instead of a single detection");
+  cmd->add_flag("--force", a->force, "Overwrite existing output files");
+  cmd->callback([a, &g]() { g.exit_code = run_guarded("detect", [&] { return run_detect(*a, g); }); });
+}
+
+}  // namespace dynid::cli

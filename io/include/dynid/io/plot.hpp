@@ -1,0 +1,43 @@
+// dynid/io/plot.hpp -- figures (PNG or SVG) drawn with PLplot (Debian's libplplot, cairo drivers).
+#pragma once
+
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace dynid::plot {
+
+enum class Kind { kLine, kMarkers, kLineMarkers, kBars, kStems };
+
+struct Series {
+  std::string label;
+  std::vector<double> x, y;
+  Kind kind = Kind::kLine;
+  int color = -1;        ///< palette index 0..9 (-1: next in the panel)
+  double width = 1.6;    ///< line width
+  double bar_width = 0.8;
+};
+
+struct Panel {
+  std::string title, xlabel, ylabel;
+  bool log_y = false;    ///< values <= 0 are drawn at the bottom of the axis
+  std::vector<Series> series;
+  std::vector<std::pair<double, std::string>> xticks;  ///< categorical labels at positions (empty: numeric)
+  double xmin = std::numeric_limits<double>::quiet_NaN(), xmax = xmin, ymin = xmin, ymax = xmin;
+  std::vector<std::pair<double, std::string>> hlines;  ///< horizontal reference lines (value, label)
+  bool legend = true;
+};
+
+struct Figure {
+  std::string title;
+  int rows = 1, cols = 1;
+  int width = 1400, height = 900;  ///< pixels
+  std::vector<Panel> panels;       ///< row by row
+};
+
+/// Draws the figure to `path` (.png or .svg by extension), written atomically; refuses to replace an existing
+/// file unless `overwrite`. Throws InputError (bad path or extension) or std::runtime_error (plotting failed).
+void save(const Figure& figure, const std::string& path, bool overwrite);
+
+}  // namespace dynid::plot

@@ -1,0 +1,129 @@
+#include "dynid/io/modal_data_io.hpp"
+
+#include <cctype>
+#include <fstream>
+#include <sstream>
+
+#include "dynid/io/output.hpp"
+#include "dynid/mesh/error.hpp"
+
+namespace dynid {
+
+bool parse_dof_label(const std::string& label, MeasuredDof* out, double* sign) {
+  std::size_t i = 0;
+  while (i < label.size() && std::isspace(static_cast<unsigned char>(label[i]))) ++i;
+  const std::size_t start = i;
+  if (i < label.size() && (label[i] == '-' || label[i] == '+')) ++i;
+  while (i < label.size() && std::isdigit(static_cast<unsigned char>(label[i]))) ++i;
+  if (i == start || (i == start + 1 && !std::isdigit(static_cast<unsigned char>(label[start])))) return false;
+  long long node = 0;
+  try {
+    node = std::stoll(label.substr(start, i - start));
+  } catch (...) {
+    return false;
+  }
+  if (node < -2147483647LL || node > 2147483647LL) return false;
+  std::string rest = label.substr(i);
+  while (!rest.empty() && std::isspace(static_cast<unsigned char>(rest.back()))) rest.pop_back();
+  double s = 1.0;
+  if (!rest.empty() && rest[0] == ':') rest = rest.substr(1);
+  Dof d;
+  if (rest.size() == 2 && (rest[0] == '+' || rest[0] == '-')) {  // UFF: +X, -Y, +Z (translations)
+    s = rest[0] == '-' ? -1.0 : 1.0;
+    const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(rest[1])));
+    if (c != 'X' && c != 'Y' && c != 'Z') return false;
+    d = static_cast<Dof>(c - 'X');
+  } else if (!parse_dof(rest, &d)) {
+    return false;
+  }
+  out->node = static_cast<int>(node);
+  out->dof = d;
+  if (sign) *sign = s;
+  return true;
+}
+
+ModalData parse_modal_data_json(const std::string& text, const std::string& name) {
+  nlohmann::ordered_json j;  // keeps the DOFs in the file's order
+  try {
+    j = nlohmann::ordered_json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(name + ": not valid JSON (byte " + std::to_string(e.byte) + "): " + e.what());
+  }
+  if (!j.is_object() || !j.contains("modes") || !j["modes"].is_array())
+    throw InputError(name + ": expected an object with a \"modes\" list");
+  const auto& modes = j["modes"];
+  if (modes.empty()) throw InputError(name + ": \"modes\" is empty");
+  ModalData d;
+  d.source = name;
+  std::vector<double> sign;
+  for (std::size_t k = 0; k < modes.size(); ++k) {
+    const auto& m = modes[k];
+    const std::string who = name + ": mode " + std::to_string(k + 1);
+    if (!m.is_object()) throw InputError(who + ": expected an object");
+    if (!m.contains("frequency_hz") || !m["frequency_hz"].is_number()) throw InputError(who + ": \"frequency_hz\" (a number) is missing");
+    if (!m.contains("shape") || !m["shape"].is_object()) throw InputError(who + ": \"shape\" must be an object {dof: value}");
+    const auto& sh = m["shape"];
+    if (k == 0) {
+      for (auto it = sh.begin(); it != sh.end(); ++it) {
+        MeasuredDof md;
+        double s = 1;
+        if (!parse_dof_label(it.key(), &md, &s))
+          throw InputError(who + ": \"" + it.key() + "\" is not a DOF label (expected node id + direction, e.g. \"13ux\" or \"13+X\")");
+        d.dofs.push_back(md);
+        sign.push_back(s);
+      }
+      d.shapes.resize(static_cast<Eigen::Index>(d.dofs.size()), static_cast<Eigen::Index>(modes.size()));
+      d.frequencies_hz.resize(static_cast<Eigen::Index>(modes.size()));
+    }
+    if (sh.size() != d.dofs.size())
+      throw InputError(who + ": has " + std::to_string(sh.size()) + " DOFs, mode 1 has " + std::to_string(d.dofs.size()));
+    std::size_t r = 0;
+    for (auto it = sh.begin(); it != sh.end(); ++it, ++r) {
+      MeasuredDof md;
+      double s = 1;
+      if (!parse_dof_label(it.key(), &md, &s) || !(md == d.dofs[r]))
+        throw InputError(who + ": DOF \"" + it.key() + "\" differs from mode 1's DOFs (every mode must list the same DOFs)");
+      if (!it.value().is_number()) throw InputError(who + ": value of \"" + it.key() + "\" is not a number");
+      d.shapes(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(k)) = sign[r] * it.value().get<double>();
+    }
+    d.frequencies_hz[static_cast<Eigen::Index>(k)] = m["frequency_hz"].get<double>();
+  }
+  bool damping = true;
+  for (const auto& m : modes) damping = damping && m.contains("damping_ratio") && m["damping_ratio"].is_number();
+  if (damping) {
+    d.damping_ratios.resize(static_cast<Eigen::Index>(modes.size()));
+    for (std::size_t k = 0; k < modes.size(); ++k) d.damping_ratios[static_cast<Eigen::Index>(k)] = modes[k]["damping_ratio"].get<double>();
+  }
+  d.validate(name);
+  return d;
+}
+
+ModalData read_modal_data(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open for reading");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_modal_data_json(ss.str(), path);
+}
+
+nlohmann::ordered_json modal_data_json(const ModalData& d) {
+  nlohmann::ordered_json modes = nlohmann::ordered_json::array();
+  for (Eigen::Index k = 0; k < d.frequencies_hz.size(); ++k) {
+    nlohmann::ordered_json m;
+    m["frequency_hz"] = d.frequencies_hz[k];
+    if (d.damping_ratios.size() == d.frequencies_hz.size()) m["damping_ratio"] = d.damping_ratios[k];
+    nlohmann::ordered_json sh = nlohmann::ordered_json::object();
+    for (std::size_t r = 0; r < d.dofs.size(); ++r) sh[to_string(d.dofs[r])] = d.shapes(static_cast<Eigen::Index>(r), k);
+    m["shape"] = sh;
+    modes.push_back(m);
+  }
+  nlohmann::ordered_json out;
+  out["modes"] = modes;
+  return out;
+}
+
+void write_modal_data(const std::string& path, const ModalData& d, bool overwrite) {
+  write_file_atomic(path, modal_data_json(d).dump(1) + "\n", overwrite);
+}
+
+}  // namespace dynid
