@@ -58,6 +58,7 @@ nlohmann::json summary_json(const Case& c, const Model& model, const DetectSumma
   j["quantification"] = q;
   j["first_order_condition"] = S.first_order_condition;
   j["serep"] = {{"modes", S.serep_modes}, {"rank", S.serep_rank}};
+  j["localization"]["confidence_set"] = S.confidence_set;
   j["warnings"] = S.warnings;
   (void)model;
   return j;
@@ -138,17 +139,18 @@ int run_detect(const DetectArgs& a, const GlobalOptions& g) {
                "frequency noise {:.2g} %, seed {}\n",
                c.name, id, 100 * d.changes[0].second.first, 100 * d.changes[0].second.second, d.study.trials,
                d.study.modes, d.study.dofs.size(), 100 * d.study.frequency_noise, d.study.seed);
-    fmt::print("| shape noise | paper pseudo residual: 1st | top 3 | dynid: 1st | top 3 | twin ranked 1st | twin called |\n"
-               "|---|---|---|---|---|---|---|\n");
+    fmt::print("| shape noise | paper pseudo residual: 1st | top 3 | dynid: 1st | top 3 | in 95 % set | mean set size | "
+               "twin ranked 1st | twin called |\n|---|---|---|---|---|---|---|---|---|\n");
     nlohmann::json out = nlohmann::json::array();
     for (const auto& r : rows) {
       auto pct = [&](int k) { return 100.0 * k / r.trials; };
-      fmt::print("| {:.0f} % | {:.1f} % | {:.1f} % | {:.1f} % | {:.1f} % | {:.1f} % | {:.1f} % |\n", 100 * r.shape_noise,
-                 pct(r.pseudo_first), pct(r.pseudo_top3), pct(r.dynid_first), pct(r.dynid_top3), pct(r.twin_first),
-                 pct(r.twin_called));
+      fmt::print("| {:.0f} % | {:.1f} % | {:.1f} % | {:.1f} % | {:.1f} % | {:.1f} % | {:.2f} | {:.1f} % | {:.1f} % |\n",
+                 100 * r.shape_noise, pct(r.pseudo_first), pct(r.pseudo_top3), pct(r.dynid_first), pct(r.dynid_top3),
+                 pct(r.in_confidence_set), r.mean_set_size, pct(r.twin_first), pct(r.twin_called));
       out.push_back({{"shape_noise", r.shape_noise}, {"trials", r.trials}, {"pseudo_first", r.pseudo_first},
                      {"pseudo_top3", r.pseudo_top3}, {"dynid_first", r.dynid_first}, {"dynid_top3", r.dynid_top3},
-                     {"twin_first", r.twin_first}, {"twin_called", r.twin_called}});
+                     {"twin_first", r.twin_first}, {"twin_called", r.twin_called},
+                     {"in_confidence_set", r.in_confidence_set}, {"mean_set_size", r.mean_set_size}});
     }
     if (!a.json.empty()) write_file_atomic(a.json, nlohmann::json{{"case", c.name}, {"element", id}, {"study", out}}.dump(1) + "\n", a.force);
     return 0;

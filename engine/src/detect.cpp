@@ -521,8 +521,20 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
     std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return scores[x].chi2 < scores[y].chi2; });
   for (std::size_t k = 0; k < order.size(); ++k) scores[order[k]].rank = static_cast<int>(k) + 1;
   for (int e : flagged) scores[e].flagged = true;
-  const double twin_tol = S.full_dofs ? 1e-9 : chi2_2dof(0.05);  // indistinguishable at the 95 % level
+  std::vector<int> conf;  // element indices in the 95 % confidence set
+  for (int e : order) {
+    const ElementScore& b = scores[order.front()];
+    const bool in = S.full_dofs ? scores[e].probability >= b.probability - 1e-9
+                                : scores[e].chi2 - b.chi2 < chi2_2dof(0.05);
+    if (in) {
+      conf.push_back(e);
+      S.confidence_set.push_back(model.elements()[e].id);
+    }
+  }
+  // Mirror twins of the elements still in question (flagged or in the confidence set) that fit as well.
+  const double twin_tol = S.full_dofs ? 1e-9 : chi2_2dof(0.05);
   for (int e : cand) {
+    if (!scores[e].flagged && std::find(conf.begin(), conf.end(), e) == conf.end()) continue;
     for (int t : element_twins(syms, e)) {
       if (!scores.count(t)) continue;
       const double d = S.full_dofs ? std::abs(scores[t].probability - scores[e].probability)
@@ -531,6 +543,13 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
     }
   }
   for (int e : order) S.elements.push_back(scores[e]);
+  if (S.confidence_set.size() > 1 && !S.confidence_set.empty()) {
+    std::string ids;
+    for (int id : S.confidence_set) ids += (ids.empty() ? "" : ", ") + std::to_string(id);
+    S.warnings.push_back("the data cannot tell apart elements " + ids +
+                         " (each fits within the 95 % chi-square band of the best); the ranking among them is not "
+                         "significant");
+  }
   for (int e : flagged)
     if (!scores[e].twins.empty()) {
       std::string t;
@@ -656,6 +675,8 @@ std::vector<NoiseStudyRow> noise_study(const Model& reference, const Model& chan
         }
         if (es.rank == 1 && std::find(twin_ids.begin(), twin_ids.end(), es.element) != twin_ids.end()) ++row.twin_first;
       }
+      row.in_confidence_set += std::count(s.confidence_set.begin(), s.confidence_set.end(), element_id) > 0;
+      row.mean_set_size += static_cast<double>(s.confidence_set.size()) / o.trials;
     }
     rows.push_back(row);
   }

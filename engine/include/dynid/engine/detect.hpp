@@ -60,6 +60,9 @@ struct DetectSummary {
   Eigen::VectorXd pseudo_reference;     ///< reference state's (zero when the reference is the model)
   Eigen::VectorXd delta_pseudo;         ///< pseudo - pseudo_reference
   std::vector<ElementScore> elements;   ///< every candidate, sorted by rank
+  /// Elements the data cannot rule out as the single changed one: chi-square within the 95 % quantile
+  /// (2 dof: 5.99) of the best (measured DOFs), or explaining as much residual force as the best (full DOFs).
+  std::vector<int> confidence_set;
   std::vector<ElementAmount> amounts;   ///< quantification of the flagged elements
   std::vector<int> used_modes;          ///< changed-state modes used (0-based)
   Eigen::VectorXd model_hz, changed_hz, mac;  ///< paired frequencies and MAC of the used modes
@@ -102,6 +105,8 @@ struct NoiseStudyRow {
   int dynid_first = 0, dynid_top3 = 0;    ///< dynid's sensitivity fit
   int twin_first = 0;                     ///< dynid ranked a mirror twin of the changed element first
   int twin_called = 0;                    ///< dynid named the changed element and its twin as indistinguishable
+  int in_confidence_set = 0;              ///< the changed element was in dynid's 95 % confidence set
+  double mean_set_size = 0;               ///< average size of that set
 };
 std::vector<NoiseStudyRow> noise_study(const Model& reference, const Model& changed, int element_id,
                                        const NoiseStudyOptions& options);
