@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -225,10 +226,18 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
     eo.method = EigenOptions::Method::kDense;
     eo.num_modes = n;
   } else {
-    eo.num_modes = std::min(n - 1, std::max(nrb + 2 * changed.num_modes() + 10, m_serep));
+    eo.num_modes = std::min(n - 1, std::max(nrb + changed.num_modes() + std::max(10, changed.num_modes() / 2), m_serep));
   }
+  using Clock = std::chrono::steady_clock;
+  auto t_stage = Clock::now();
+  auto lap = [&]() {
+    const double t = std::chrono::duration<double>(Clock::now() - t_stage).count();
+    t_stage = Clock::now();
+    return t;
+  };
   const ModalResult ref = modal_analysis(model, eo);
   if (!ref.ok()) throw NumericalError("detect: modal analysis of the reference model failed: " + ref.summary.message);
+  S.time_modal = lap();
   m_serep = std::min<int>(m_serep, static_cast<int>(ref.eigenvalues.size()));
 
   const Paired pc = pair_with_model(changed, rows, ref, o.modes, o.min_mac, "changed-state");
@@ -370,11 +379,23 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
         }
       }
     };
-    // Single-element explained energy for every candidate (its ranking).
+    // Only elements with residual force on their DOFs can explain any of it; the others score 0.
+    const Eigen::VectorXd row_energy = S.residuals.rowwise().squaredNorm();
+    std::vector<int> support;
+    for (int e : cand) {
+      model.element_dofs(e, &dofs);
+      double en = 0;
+      for (int d : dofs)
+        if (d >= 0) en = std::max(en, row_energy[d]);
+      if (en > 1e-24 * total) support.push_back(e);
+      scores[e].probability = 0;
+      scores[e].chi2 = 1;
+    }
+    // Single-element explained energy (the ranking).
     Eigen::VectorXd y;
     Eigen::MatrixXd A;
     std::vector<int> rr;
-    for (int e : cand) {
+    for (int e : support) {
       element_system(e, S.residuals, &y, &A, &rr);
       const LeastSquaresResult ls = least_squares(A, y);
       const double expl = total > 0 ? (y.squaredNorm() - ls.residual_norm * ls.residual_norm) / total : 0.0;
@@ -389,7 +410,7 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
       if (!(left > 1e-12 * total)) break;
       int best = -1;
       double best_expl = 0;
-      for (int e : cand) {
+      for (int e : support) {
         if (std::find(sel.begin(), sel.end(), e) != sel.end()) continue;
         element_system(e, Rleft, &y, &A, &rr);
         const LeastSquaresResult ls = least_squares(A, y);
@@ -558,6 +579,7 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
                            " that the data cannot tell apart: the change is in one of them");
     }
 
+  S.time_localization = lap();
   // ---- quantification ------------------------------------------------------------------------------------
   if (!flagged.empty() && !o.localize_only) {
     for (int e : flagged) add_params(e);
@@ -622,6 +644,7 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
       }
     }
   }
+  S.time_quantification = lap();
   return S;
 }
 

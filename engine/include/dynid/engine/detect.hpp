@@ -74,6 +74,7 @@ struct DetectSummary {
   std::string method;                   ///< which localizer decided the flags
   double first_order_condition = 0;     ///< cond(L) of eq. (18)
   int refine_iterations = 0;
+  double time_modal = 0, time_localization = 0, time_quantification = 0;  ///< seconds
 };
 
 /// Locates and quantifies the change between a reference model and a changed state known by its modal data
