@@ -1,20 +1,24 @@
 #!/usr/bin/env bash
-# Runs dynid on every bundled case (cases/*/), writing results under out/ (override with DYNID_OUT).
-# Each case folder's README says what it shows; this is the "main job" of the README's first command.
+# Runs dynid on every bundled case (cases/**/*.yaml): `detect` for cases with a detect: section, `modal`
+# otherwise. Results (JSON, and plots for detect) go to out/ (override with DYNID_OUT). This is the "main job"
+# of the README's first command; each case folder's README says what the case shows.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 dynid=${DYNID_BIN:-$here/build/cli/dynid}
 out=${DYNID_OUT:-$here/out}
 mkdir -p "$out"
 status=0
-for dir in "$here"/cases/*/; do
-  name=$(basename "$dir")
-  [ -f "$dir/case.yaml" ] || [ -f "$dir/case.json" ] || continue
-  echo "== $name"
-  if ! "$dynid" modal "$dir" --json "$out/$name.modal.json" --force; then
-    echo "!! $name failed" >&2
-    status=1
+while IFS= read -r file; do
+  rel=${file#"$here/cases/"}
+  name=$(echo "${rel%.yaml}" | tr '/' '-')
+  name=${name%-case}
+  if grep -q '^detect:' "$file"; then
+    echo "== detect $rel"
+    "$dynid" detect "$file" --json "$out/$name.detect.json" --force || { echo "!! $rel failed" >&2; status=1; }
+  else
+    echo "== modal $rel"
+    "$dynid" modal "$file" --json "$out/$name.modal.json" --force || { echo "!! $rel failed" >&2; status=1; }
   fi
-done
+done < <(find "$here/cases" -name '*.yaml' | sort)
 echo "results in $out"
 exit $status
