@@ -26,6 +26,7 @@ TEST(PaperModal, Table1FreeFreeBeam) {
 }
 
 TEST(PaperModal, Table2FiveStoryFrame) {
+  DYNID_REQUIRE_SHARED();
   const Case c = load_case(test::CasesDir() + "/paper-frame");
   const ModalResult r = modal_analysis(c.model, c.analysis.eigen_options());
   ASSERT_TRUE(r.ok());
@@ -42,6 +43,7 @@ TEST(PaperModal, Table2FiveStoryFrame) {
 }
 
 TEST(PaperModal, FrameCaseMatchesSharedGeometry) {
+  DYNID_REQUIRE_SHARED();
   const Case c = load_case(test::CasesDir() + "/paper-frame");
   std::ifstream in(test::SharedDir() + "/cases/paper-frame.json");
   ASSERT_TRUE(in);

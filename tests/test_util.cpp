@@ -1,6 +1,7 @@
 #include "test_util.hpp"
 
 #include <Eigen/Dense>
+#include <filesystem>
 
 namespace dynid::test {
 
@@ -15,5 +16,6 @@ double SubspaceGap(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
 
 std::string CasesDir() { return DYNID_CASES_DIR; }
 std::string SharedDir() { return DYNID_SHARED_DIR; }
+bool HaveShared() { return std::filesystem::is_directory(std::string(DYNID_SHARED_DIR) + "/cases"); }
 
 }  // namespace dynid::test

@@ -33,6 +33,20 @@ double SubspaceGap(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B);
 /// Folder of the repository's bundled cases and of ../shared (set by CMake).
 std::string CasesDir();
 std::string SharedDir();
+/// Whether the shared data folder exists (tests that need it skip with a message otherwise).
+bool HaveShared();
+
+}  // namespace dynid::test
+
+/// Skips the test, saying why, when ../shared (the paper's data) is not available.
+#define DYNID_REQUIRE_SHARED()                                                                          \
+  do {                                                                                                  \
+    if (!::dynid::test::HaveShared())                                                                   \
+      GTEST_SKIP() << "shared data not found at " << ::dynid::test::SharedDir()                          \
+                   << " (clone dynid beside ../shared, or set DYNID_SHARED_DIR when configuring)";      \
+  } while (0)
+
+namespace dynid::test {
 
 /// Dense copy of a sparse matrix.
 inline Eigen::MatrixXd Dense(const SparseMatrix& A) { return Eigen::MatrixXd(A); }
