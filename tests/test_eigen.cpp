@@ -68,9 +68,13 @@ void CompareSparseDense(const Model& m, int modes) {
     EXPECT_TRUE(test::RelClose(sp.eigenvalues[k], de.eigenvalues[k], 1e-8)) << "mode " << k;
     const bool simple = (k + 1 >= modes || sp.eigenvalues[k + 1] > sp.eigenvalues[k] * (1 + 1e-6)) &&
                         (k == nr || sp.eigenvalues[k - 1] < sp.eigenvalues[k] * (1 - 1e-6));
-    if (simple) EXPECT_GT(test::Mac(sp.modes.col(k), de.modes.col(k)), 1 - 1e-8) << "mode " << k;
+    if (simple) {
+      EXPECT_GT(test::Mac(sp.modes.col(k), de.modes.col(k)), 1 - 1e-8) << "mode " << k;
+    }
   }
-  if (nr > 0) EXPECT_LT(test::SubspaceGap(sp.modes.leftCols(nr), de.modes.leftCols(nr)), 1e-8);
+  if (nr > 0) {
+    EXPECT_LT(test::SubspaceGap(sp.modes.leftCols(nr), de.modes.leftCols(nr)), 1e-8);
+  }
   const Eigen::MatrixXd M = test::Dense(sys.M);
   const Eigen::MatrixXd G = sp.modes.transpose() * M * sp.modes;
   EXPECT_LT((G - Eigen::MatrixXd::Identity(modes, modes)).cwiseAbs().maxCoeff(), 1e-10);
@@ -83,6 +87,10 @@ TEST(Eigen, SparseMatchesDensePaperBeam) {
 }
 TEST(Eigen, SparseMatchesDensePaperFrame) {
   CompareSparseDense(load_case(test::CasesDir() + "/paper-frame").model, 12);
+}
+TEST(Eigen, SparseMatchesDenseAnalyticBeams) {
+  CompareSparseDense(load_case(test::CasesDir() + "/cantilever-beam").model, 8);
+  CompareSparseDense(load_case(test::CasesDir() + "/simply-supported-beam").model, 8);
 }
 TEST(Eigen, SparseMatchesDense2DFrame) { CompareSparseDense(make_frame2d(Frame2D(3, 6, 3)), 20); }
 TEST(Eigen, SparseMatchesDense3DFrame) { CompareSparseDense(make_frame3d(Frame3D()), 20); }
@@ -162,6 +170,20 @@ TEST(Eigen, MechanismIsReportedWithItsDof) {
   EXPECT_TRUE(r.summary.message.find("node 3") != std::string::npos ||
               r.summary.message.find("node 4") != std::string::npos)
       << r.summary.message;
+}
+
+TEST(Eigen, NonConvergenceIsReported) {
+  // One restart and the smallest basis cannot converge 20 modes of a 2D frame: a status and a message that says
+  // what to change, not a crash or a silent partial answer.
+  const Model m = make_frame2d(Frame2D(3, 6, 3));
+  EigenOptions o;
+  o.num_modes = 20;
+  o.method = EigenOptions::Method::kSparse;
+  o.max_restarts = 1;
+  o.subspace = 22;
+  const ModalResult r = modal_analysis(m, o);
+  EXPECT_EQ(r.summary.status, EigenStatus::kNotConverged);
+  EXPECT_NE(r.summary.message.find("raise max_restarts"), std::string::npos) << r.summary.message;
 }
 
 TEST(Eigen, RejectsNonFiniteMatrices) {

@@ -82,7 +82,7 @@ TEST(Elements, TranslationalMassIsRhoAL) {
   // Kinetic energy of a unit rigid translation = total mass rho A L, for consistent and lumped mass (1e-14).
   const Eigen::Vector3d a(0, 0, 0), b(0.6, 0.8, 0);  // L = 1
   for (MassType mt : {MassType::Consistent, MassType::Lumped}) {
-    const Model m = OneMember(ElementType::Frame2D, a, b, {}, mt);
+    const Model m = OneMember(ElementType::Frame2D, a, b, Eigen::Vector3d::Zero(), mt);
     Eigen::MatrixXd M;
     m.element_matrices(0, nullptr, &M);
     const Eigen::MatrixXd R = m.rigid_body_motions();

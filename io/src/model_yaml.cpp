@@ -300,6 +300,15 @@ struct Parser {
       return model.materials()[i];
     };
     auto sec = [&](const char* k) -> Section { return model.sections()[section_of(s[k], kind)]; };
+    auto members = [&](auto* f) {  // what every frame generator shares
+      f->stories = integer("stories", 1);
+      f->divisions = integer("divisions", 1);
+      f->height = num("height", 1.0);
+      f->material = mat();
+      f->column = sec("column");
+      f->beam = sec("beam");
+      f->mass = model.mass_type();
+    };
     Model gen;
     if (kind == "beam") {
       ctx.only_keys(s, "generate.beam", {"length", "elements", "material", "section", "support"});
@@ -320,29 +329,17 @@ struct Parser {
       ctx.only_keys(s, "generate.frame2d", {"bays", "stories", "divisions", "span", "height", "material", "column", "beam"});
       Frame2DSpec f;
       f.bays = integer("bays", 1);
-      f.stories = integer("stories", 1);
-      f.divisions = integer("divisions", 1);
       f.span = num("span", 1.0);
-      f.height = num("height", 1.0);
-      f.material = mat();
-      f.column = sec("column");
-      f.beam = sec("beam");
-      f.mass = model.mass_type();
+      members(&f);
       gen = make_frame2d(f);
     } else if (kind == "frame3d") {
       ctx.only_keys(s, "generate.frame3d", {"bays_x", "bays_y", "stories", "divisions", "span_x", "span_y", "height", "material", "column", "beam"});
       Frame3DSpec f;
       f.bays_x = integer("bays_x", 1);
       f.bays_y = integer("bays_y", 1);
-      f.stories = integer("stories", 1);
-      f.divisions = integer("divisions", 1);
       f.span_x = num("span_x", 1.0);
       f.span_y = num("span_y", 1.0);
-      f.height = num("height", 1.0);
-      f.material = mat();
-      f.column = sec("column");
-      f.beam = sec("beam");
-      f.mass = model.mass_type();
+      members(&f);
       gen = make_frame3d(f);
     } else {
       fail(g.begin()->first, "generate: unknown generator '" + kind + "' (known: beam, frame2d, frame3d)");
