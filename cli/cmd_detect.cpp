@@ -157,23 +157,11 @@ int run_detect(const DetectArgs& a, const GlobalOptions& g) {
   }
 
   // The changed state: a simulation of the modified model, or measured data.
-  ModalData changed;
   Model changed_m;
   DetectOptions opt = d.options;
-  if (!d.changes.empty()) {
-    changed_m = changed_model(model, d.changes);
-    EigenOptions eo;
-    const int nrb = changed_m.free_free() ? static_cast<int>(changed_m.free_rigid_body_modes().cols()) : 0;
-    const int p = opt.modes > 0 ? opt.modes : 6;
-    eo.num_modes = nrb + p;
-    progress.update("changed modes", -1);
-    const ModalResult r = modal_analysis(changed_m, eo);
-    if (!r.ok()) throw NumericalError("modal analysis of the changed model failed: " + r.summary.message);
-    changed = sample_modes(changed_m, r, d.measured_dofs, nrb, p, "simulation of " + c.name);
-    opt.simulated_changed = &changed_m;
-  } else {
-    changed = read_modal_data(d.measured_file);
-  }
+  progress.update("changed state", -1);
+  const ModalData changed = detect_changed_data(c, &changed_m);
+  if (!d.changes.empty()) opt.simulated_changed = &changed_m;
   ModalData refmeas;
   if (!d.reference_measured_file.empty()) refmeas = read_modal_data(d.reference_measured_file);
   progress.update("detect", -1);

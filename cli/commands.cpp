@@ -30,6 +30,7 @@ int run_guarded(const std::string& command, const std::function<int()>& body) {
 void register_commands(CLI::App& app, GlobalOptions& g) {
   register_modal(app, g);
   register_detect(app, g);
+  register_update(app, g);
 }
 
 }  // namespace dynid::cli

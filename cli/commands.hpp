@@ -22,5 +22,6 @@ int run_guarded(const std::string& command, const std::function<int()>& body);
 void register_commands(CLI::App& app, GlobalOptions& g);
 void register_modal(CLI::App& app, GlobalOptions& g);
 void register_detect(CLI::App& app, GlobalOptions& g);
+void register_update(CLI::App& app, GlobalOptions& g);
 
 }  // namespace dynid::cli

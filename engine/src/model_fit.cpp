@@ -3,6 +3,7 @@
 #include <ceres/ceres.h>
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -58,9 +59,17 @@ struct Evaluation {
 
 class Evaluator {
  public:
+  // x (the optimiser's variables) drives the free parameters free[k]; tied parameters follow x[k] by a ratio.
   Evaluator(const ParametricModel& pm, const ModalData& meas, const Eigen::VectorXd& theta0, std::vector<int> free,
             const FitOptions& o)
       : pm_(pm), meas_(meas), theta0_(theta0), free_(std::move(free)), o_(o), solver_(EigenOptions{}) {
+    xmap_.resize(free_.size());
+    for (std::size_t k = 0; k < free_.size(); ++k) xmap_[k].push_back({free_[k], 1.0});
+    for (const auto& [p, t] : o.ties) {
+      const auto it = std::find(free_.begin(), free_.end(), t.first);
+      if (it == free_.end()) continue;  // tied to a fixed parameter: constant, handled by theta0
+      xmap_[static_cast<std::size_t>(it - free_.begin())].push_back({p, t.second});
+    }
     rows_ = measured_equations(pm.model(), meas.dofs);
     const Model& model = pm.model();
     const int n = model.num_dofs();
@@ -91,8 +100,16 @@ class Evaluator {
 
   Eigen::VectorXd theta_of(const double* x) const {
     Eigen::VectorXd t = theta0_;
-    for (std::size_t k = 0; k < free_.size(); ++k) t[free_[k]] = x[k];
+    for (std::size_t k = 0; k < xmap_.size(); ++k)
+      for (const auto& [p, c] : xmap_[k]) t[p] = c * x[k];
     return t;
+  }
+  // Column of dr/dx_f from the parameter columns: sum over the parameters x_f drives.
+  template <class Col>
+  Eigen::VectorXd xcol(std::size_t f, const Col& col) const {
+    Eigen::VectorXd v = xmap_[f][0].second * col(xmap_[f][0].first);
+    for (std::size_t q = 1; q < xmap_[f].size(); ++q) v += xmap_[f][q].second * col(xmap_[f][q].first);
+    return v;
   }
   int rows_per_mode() const {
     switch (o_.objective) {
@@ -244,8 +261,7 @@ class Evaluator {
         const Eigen::VectorXd x = Ps_ * u;
         const Eigen::VectorXd lx = (lam_m_.array() - lam_meas_[k]).matrix().cwiseProduct(x);
         Eigen::MatrixXd Jk(a, nf);
-        for (Eigen::Index f = 0; f < nf; ++f) {
-          const int q = free_[f];
+        auto col = [&](int q) -> Eigen::VectorXd {
           Eigen::MatrixXd dPa(a, m);
           for (Eigen::Index j = 0; j < m; ++j) dPa.col(j) = dphi[j].col(q);
           // d(Phi_a^+) for full column rank: -P dPa P + G dPa^T (I - Phi_a P).
@@ -253,8 +269,9 @@ class Evaluator {
           const Eigen::VectorXd dx = dP * u;
           const Eigen::VectorXd dl = dlam.col(q);
           const Eigen::VectorXd dr = dP.transpose() * lx + Ps_.transpose() * (dl.cwiseProduct(x) + (lam_m_.array() - lam_meas_[k]).matrix().cwiseProduct(dx));
-          Jk.col(f) = dr / serep_scale_[k];
-        }
+          return dr / serep_scale_[k];
+        };
+        for (Eigen::Index f = 0; f < nf; ++f) Jk.col(f) = xcol(static_cast<std::size_t>(f), col);
         ev_.J[k] = Jk;
       }
       ev_.has_jacobian = true;
@@ -268,19 +285,25 @@ class Evaluator {
       double w = 1.0 / sigma_lambda(k);
       if (o_.objective == FitObjective::kFrequencyMac) w /= std::max(ev_.mac[k], 1e-3);
       Eigen::MatrixXd Jk(rows_per_mode(), nf);
-      for (Eigen::Index f = 0; f < nf; ++f) Jk(0, f) = dlam(k, free_[f]) * w;
+      Eigen::VectorXd v(a);
+      double vv = 1, c = 0;
       if (o_.objective == FitObjective::kCombined) {
         const int i = ev_.pair[k];
-        Eigen::VectorXd v(a);
         for (Eigen::Index r = 0; r < a; ++r) v[r] = ev_.ms.Phi(rows_[r], i);
-        const double vv = v.squaredNorm();
-        const double c = U_.col(k).dot(v) / vv;
-        for (Eigen::Index f = 0; f < nf; ++f) {
-          const Eigen::VectorXd dv = dphi[k].col(free_[f]);
-          const double dc = U_.col(k).dot(dv) / vv - 2.0 * c * v.dot(dv) / vv;
-          Jk.col(f).tail(a) = (dc * v + c * dv) / o_.shape_noise;
-        }
+        vv = v.squaredNorm();
+        c = U_.col(k).dot(v) / vv;
       }
+      auto col = [&](int q) -> Eigen::VectorXd {
+        Eigen::VectorXd out(rows_per_mode());
+        out[0] = dlam(k, q) * w;
+        if (o_.objective == FitObjective::kCombined) {
+          const Eigen::VectorXd dv = dphi[k].col(q);
+          const double dc = U_.col(k).dot(dv) / vv - 2.0 * c * v.dot(dv) / vv;
+          out.tail(a) = (dc * v + c * dv) / o_.shape_noise;
+        }
+        return out;
+      };
+      for (Eigen::Index f = 0; f < nf; ++f) Jk.col(f) = xcol(static_cast<std::size_t>(f), col);
       ev_.J[k] = Jk;
     }
     ev_.has_jacobian = true;
@@ -290,6 +313,7 @@ class Evaluator {
   const ModalData& meas_;
   Eigen::VectorXd theta0_;
   std::vector<int> free_;
+  std::vector<std::vector<std::pair<int, double>>> xmap_;  // x_k -> (parameter, coefficient)
   FitOptions o_;
   EigenSolver solver_;
   std::vector<int> rows_;
@@ -379,9 +403,19 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
     throw InputError("fit: " + std::to_string(theta0.size()) + " start values for " + std::to_string(pm.num_parameters()) + " parameters");
   if (!is_free.empty() && static_cast<int>(is_free.size()) != pm.num_parameters())
     throw InputError("fit: free-parameter mask has the wrong size");
+  std::vector<char> tied(static_cast<std::size_t>(pm.num_parameters()), 0);
+  for (const auto& [p, t] : o.ties) {
+    if (p < 0 || p >= pm.num_parameters() || t.first < 0 || t.first >= pm.num_parameters() || p == t.first)
+      throw InputError("fit: invalid tie between parameters " + std::to_string(p) + " and " + std::to_string(t.first));
+    tied[p] = 1;
+  }
+  for (const auto& [p, t] : o.ties)
+    if (tied[t.first])
+      throw InputError("fit: parameter '" + pm.parameter(p).name + "' is tied to '" + pm.parameter(t.first).name +
+                       "', which is itself tied; tie both to the same free parameter");
   std::vector<int> free;
   for (int p = 0; p < pm.num_parameters(); ++p)
-    if (is_free.empty() || is_free[p]) free.push_back(p);
+    if ((is_free.empty() || is_free[p]) && !tied[p]) free.push_back(p);
   if (free.empty()) throw InputError("fit: no free parameters");
   for (int p = 0; p < pm.num_parameters(); ++p) {
     const Parameter& q = pm.parameter(p);
@@ -446,8 +480,7 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
   out.initial_cost = sum.initial_cost;
   out.final_cost = sum.final_cost;
   out.report = sum.FullReport();
-  out.theta = theta0;
-  for (int k = 0; k < nf; ++k) out.theta[free[k]] = x[k];
+  out.theta = ev->theta_of(x.data());
 
   const Evaluation& ef = ev->at(x.data(), true);
   if (!ef.ok) throw NumericalError("fit: the model cannot be evaluated at the solution: " + ef.error);
@@ -475,32 +508,36 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
         J.row(r0 + k).setZero();
         J(r0 + k, k) = std::sqrt(o.regularization) / pm.parameter(free[k]).scale;
       }
-    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeThinV);
+    // Full V: its columns beyond the numerical rank span the null space of J (directions the data do not see).
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullV);
     const Eigen::VectorXd& sv = svd.singularValues();
     const double tol = 1e-8 * (sv.size() ? sv[0] : 0.0);
-    Eigen::VectorXd inv2 = Eigen::VectorXd::Zero(sv.size());
+    Eigen::VectorXd inv2 = Eigen::VectorXd::Zero(nf);
     for (Eigen::Index i = 0; i < sv.size(); ++i)
       if (sv[i] > tol) {
         inv2[i] = 1.0 / (sv[i] * sv[i]);
         ++out.covariance_rank;
       }
     if (o.covariance) {
-      const Eigen::MatrixXd C = svd.matrixV() * inv2.asDiagonal() * svd.matrixV().transpose();
+      const Eigen::MatrixXd& V = svd.matrixV();
+      const Eigen::MatrixXd C = V * inv2.asDiagonal() * V.transpose();
       out.covariance_ok = out.covariance_rank == nf;
       for (int k = 0; k < nf; ++k) {
-        // A parameter is estimable when it is orthogonal to the null space of J.
+        // A parameter is estimable when it has no component in the null space of J.
         double in_null = 0;
-        for (Eigen::Index i = 0; i < sv.size(); ++i)
-          if (sv[i] <= tol) in_null += svd.matrixV()(k, i) * svd.matrixV()(k, i);
+        for (Eigen::Index i = out.covariance_rank; i < nf; ++i) in_null += V(k, i) * V(k, i);
         if (in_null < 1e-6) out.stddev[free[k]] = std::sqrt(C(k, k));
       }
     }
+    for (const auto& [p, t] : o.ties)
+      if (!std::isnan(out.stddev[t.first])) out.stddev[p] = std::abs(t.second) * out.stddev[t.first];
     if (out.covariance_rank < nf)
       out.warnings.push_back("the data determine only " + std::to_string(out.covariance_rank) + " of the " +
                              std::to_string(nf) + " free parameters (J^T J is rank-deficient): the others trade off "
                              "against each other; fix or tie parameters, or add modes or DOFs");
   }
   const int ndata = measured.num_modes() * ev->rows_per_mode();
+  if (ndata > nf) out.residual_scale = std::sqrt(2.0 * out.final_cost / (ndata - nf));
   if (nf > ndata)
     out.warnings.push_back(std::to_string(nf) + " free parameters but only " + std::to_string(ndata) + " data values");
   for (int k = 0; k < nf; ++k) {
@@ -543,6 +580,42 @@ Linearization linearize(const ParametricModel& pm, const ModalData& measured, co
   L.forced = e.forced;
   return L;
 }
+
+struct FitProblem::Impl {
+  std::unique_ptr<Evaluator> ev;
+  std::vector<int> all;
+};
+
+FitProblem::FitProblem(const ParametricModel& pm, const ModalData& measured, const FitOptions& o)
+    : impl_(std::make_unique<Impl>()) {
+  std::string why;
+  if (!o.IsValid(&why)) throw InputError("fit options: " + why);
+  measured.validate("measured modal data");
+  for (int p = 0; p < pm.num_parameters(); ++p) impl_->all.push_back(p);
+  impl_->ev = std::make_unique<Evaluator>(pm, measured, pm.nominal(), impl_->all, o);
+}
+FitProblem::~FitProblem() = default;
+
+bool FitProblem::residuals(const Eigen::VectorXd& theta, Eigen::VectorXd* r) {
+  const Evaluation& e = impl_->ev->at(theta.data(), false);
+  if (!e.ok) return false;
+  Eigen::Index n = 0;
+  for (const auto& b : e.r) n += b.size();
+  r->resize(n);
+  n = 0;
+  for (const auto& b : e.r) {
+    r->segment(n, b.size()) = b;
+    n += b.size();
+  }
+  return true;
+}
+
+double FitProblem::cost(const Eigen::VectorXd& theta) {
+  Eigen::VectorXd r;
+  return residuals(theta, &r) ? 0.5 * r.squaredNorm() : std::numeric_limits<double>::infinity();
+}
+
+int FitProblem::evaluations() const { return impl_->ev->evaluations(); }
 
 Correlation correlate(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta, double min_mac) {
   FitOptions o;

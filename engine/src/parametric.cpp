@@ -1,6 +1,7 @@
 #include "dynid/engine/parametric.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 
 #include "dynid/engine/modal.hpp"
@@ -18,6 +19,23 @@ std::string_view parameter_kind_name(ParameterKind k) {
     case ParameterKind::kSpring: return "spring";
   }
   return "?";
+}
+
+Model apply_factors(const Model& model, const std::vector<std::pair<int, PropertyFactors>>& changes) {
+  Model m = model;
+  for (const auto& [id, f] : changes) {
+    const int e = m.element_index(id);
+    if (e < 0) throw InputError("element " + std::to_string(id) + " does not exist");
+    for (double v : {f.E, f.rho, f.A, f.I})
+      if (!(v > 0 && std::isfinite(v))) throw InputError("element " + std::to_string(id) + ": factors must be finite and > 0");
+    PropertyFactors& g = m.element(e).factors;
+    g.E *= f.E;
+    g.rho *= f.rho;
+    g.A *= f.A;
+    g.I *= f.I;
+  }
+  m.finalize();
+  return m;
 }
 
 ParametricModel::ParametricModel(const Model& model) : model_(model) {
@@ -43,9 +61,11 @@ int ParametricModel::add(const Parameter& p) {
     for (int e : p.elements) {
       if (e < 0 || e >= model_.num_elements()) throw InputError(who + ": element index " + std::to_string(e) + " does not exist");
       const ElementType t = model_.elements()[e].type;
-      if (t == ElementType::PointMass || t == ElementType::Spring)
-        throw InputError(who + ": element " + std::to_string(model_.elements()[e].id) +
-                         " is a point mass or spring; factors act on beams and frames");
+      const std::string eid = "element " + std::to_string(model_.elements()[e].id);
+      if (t == ElementType::Spring && p.kind != ParameterKind::kStiffness)
+        throw InputError(who + ": " + eid + " is a spring; only a stiffness factor (E) acts on it");
+      if (t == ElementType::PointMass && p.kind != ParameterKind::kMass)
+        throw InputError(who + ": " + eid + " is a point mass; only a mass factor (rho) acts on it");
     }
   }
   if (!(p.lower <= p.nominal && p.nominal <= p.upper))
@@ -94,10 +114,13 @@ void ParametricModel::build() const {
       bool e, rho, a, i;  // which kinds act on it
     };
     const Eigen::MatrixXd Kbt = parts.K_bending + parts.K_torsion;
+    // Springs scale with a stiffness factor, point masses with a mass factor.
     const PartDef defs[] = {{&parts.K_axial, false, true, false, true, false},
                             {&Kbt, false, true, false, false, true},
+                            {&parts.K_discrete, false, true, false, false, false},
                             {&parts.M_translational, true, false, true, true, false},
-                            {&parts.M_rotary, true, false, true, false, true}};
+                            {&parts.M_rotary, true, false, true, false, true},
+                            {&parts.M_discrete, true, false, true, false, false}};
     for (const PartDef& d : defs) {
       if (d.m->cwiseAbs().maxCoeff() == 0.0) continue;
       Term t;

@@ -6,6 +6,7 @@
 
 #include "dynid/engine/modal.hpp"
 #include "dynid/io/modal_data_io.hpp"
+#include "internal/case_util.hpp"
 #include "internal/model_yaml.hpp"
 
 namespace dynid {
@@ -13,46 +14,7 @@ namespace dynid {
 namespace fs = std::filesystem;
 using internal::YamlCtx;
 
-EigenOptions AnalysisSpec::eigen_options() const {
-  EigenOptions o;
-  o.num_modes = modes;
-  if (!std::isnan(band_lo_hz)) {
-    o.band_lo = hz_to_eigenvalue(band_lo_hz);
-    o.band_hi = hz_to_eigenvalue(band_hi_hz);
-  }
-  if (!std::isnan(shift_hz)) o.shift = hz_to_eigenvalue(shift_hz);
-  o.method = method;
-  return o;
-}
-
-namespace {
-
-AnalysisSpec parse_analysis(const YAML::Node& n, const YamlCtx& ctx) {
-  AnalysisSpec a;
-  if (!n) return a;
-  ctx.require_map(n, "analysis");
-  ctx.only_keys(n, "analysis", {"modes", "band_hz", "shift_hz", "method"});
-  if (n["modes"]) {
-    a.modes = ctx.integer(n["modes"], "analysis modes");
-    if (a.modes < 1) ctx.fail(n["modes"], "analysis: modes must be >= 1");
-  }
-  if (n["band_hz"]) {
-    const auto b = ctx.numbers(n["band_hz"], "analysis band_hz");
-    if (b.size() != 2 || !(b[0] >= 0 && b[1] > b[0]))
-      ctx.fail(n["band_hz"], "analysis: band_hz must be [low, high] with 0 <= low < high");
-    a.band_lo_hz = b[0];
-    a.band_hi_hz = b[1];
-  }
-  if (n["shift_hz"]) a.shift_hz = ctx.number(n["shift_hz"], "analysis shift_hz");
-  if (n["method"]) {
-    const std::string m = ctx.string(n["method"], "analysis method");
-    if (m == "auto") a.method = EigenOptions::Method::kAuto;
-    else if (m == "sparse") a.method = EigenOptions::Method::kSparse;
-    else if (m == "dense") a.method = EigenOptions::Method::kDense;
-    else ctx.fail(n["method"], "analysis: method must be auto, sparse or dense");
-  }
-  return a;
-}
+namespace internal {
 
 // measured_dofs: all | translations | {types: [ux, uy], nodes: [...]} | [13ux, 13uy, ...]
 std::vector<MeasuredDof> parse_dof_selection(const YAML::Node& n, const YamlCtx& ctx, const Model& model,
@@ -102,17 +64,63 @@ std::vector<MeasuredDof> parse_dof_selection(const YAML::Node& n, const YamlCtx&
   return out;
 }
 
+std::string resolve(const std::string& dir, const std::string& file) {
+  const fs::path p(file);
+  return p.is_absolute() ? file : (fs::path(dir) / p).lexically_normal().string();
+}
+
+}  // namespace internal
+
+using internal::parse_dof_selection;
+using internal::resolve;
+
+EigenOptions AnalysisSpec::eigen_options() const {
+  EigenOptions o;
+  o.num_modes = modes;
+  if (!std::isnan(band_lo_hz)) {
+    o.band_lo = hz_to_eigenvalue(band_lo_hz);
+    o.band_hi = hz_to_eigenvalue(band_hi_hz);
+  }
+  if (!std::isnan(shift_hz)) o.shift = hz_to_eigenvalue(shift_hz);
+  o.method = method;
+  return o;
+}
+
+namespace {
+
+AnalysisSpec parse_analysis(const YAML::Node& n, const YamlCtx& ctx) {
+  AnalysisSpec a;
+  if (!n) return a;
+  ctx.require_map(n, "analysis");
+  ctx.only_keys(n, "analysis", {"modes", "band_hz", "shift_hz", "method"});
+  if (n["modes"]) {
+    a.modes = ctx.integer(n["modes"], "analysis modes");
+    if (a.modes < 1) ctx.fail(n["modes"], "analysis: modes must be >= 1");
+  }
+  if (n["band_hz"]) {
+    const auto b = ctx.numbers(n["band_hz"], "analysis band_hz");
+    if (b.size() != 2 || !(b[0] >= 0 && b[1] > b[0]))
+      ctx.fail(n["band_hz"], "analysis: band_hz must be [low, high] with 0 <= low < high");
+    a.band_lo_hz = b[0];
+    a.band_hi_hz = b[1];
+  }
+  if (n["shift_hz"]) a.shift_hz = ctx.number(n["shift_hz"], "analysis shift_hz");
+  if (n["method"]) {
+    const std::string m = ctx.string(n["method"], "analysis method");
+    if (m == "auto") a.method = EigenOptions::Method::kAuto;
+    else if (m == "sparse") a.method = EigenOptions::Method::kSparse;
+    else if (m == "dense") a.method = EigenOptions::Method::kDense;
+    else ctx.fail(n["method"], "analysis: method must be auto, sparse or dense");
+  }
+  return a;
+}
+
 void parse_noise(const YAML::Node& n, const YamlCtx& ctx, DetectOptions* o) {
   ctx.require_map(n, "noise");
   ctx.only_keys(n, "noise", {"frequency", "shape"});
   if (n["frequency"]) o->frequency_noise = ctx.number(n["frequency"], "noise frequency");
   if (n["shape"]) o->shape_noise = ctx.number(n["shape"], "noise shape");
   if (!(o->frequency_noise > 0) || !(o->shape_noise > 0)) ctx.fail(n, "noise: frequency and shape must be > 0 (relative std)");
-}
-
-std::string resolve(const std::string& dir, const std::string& file) {
-  const fs::path p(file);
-  return p.is_absolute() ? file : (fs::path(dir) / p).lexically_normal().string();
 }
 
 DetectSpec parse_detect(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir) {
@@ -233,7 +241,7 @@ Case parse_case(const std::string& text, const std::string& name, const std::str
   }
   if (!root || root.IsNull()) throw InputError(name + ": the case file is empty");
   ctx.require_map(root, "case file");
-  ctx.only_keys(root, "the case file", {"name", "description", "model", "analysis", "detect"});
+  ctx.only_keys(root, "the case file", {"name", "description", "model", "analysis", "detect", "update"});
   Case c;
   c.path = name;
   c.dir = dir;
@@ -248,7 +256,43 @@ Case parse_case(const std::string& text, const std::string& name, const std::str
   }
   c.analysis = parse_analysis(root["analysis"], ctx);
   if (root["detect"]) c.detect = parse_detect(root["detect"], ctx, c.model, dir);
+  if (root["update"]) c.update = internal::parse_update(root["update"], ctx, c.model, dir);
   return c;
+}
+
+namespace {
+// Exact modes of `m` at `dofs`: `count` modes after its rigid-body modes.
+ModalData simulate(const Model& m, const std::vector<MeasuredDof>& dofs, int count, const std::string& source) {
+  EigenOptions eo;
+  const int nrb = m.free_free() ? static_cast<int>(m.free_rigid_body_modes().cols()) : 0;
+  eo.num_modes = nrb + count;
+  const ModalResult r = modal_analysis(m, eo);
+  if (!r.ok()) throw NumericalError("modal analysis of " + source + " failed: " + r.summary.message);
+  return sample_modes(m, r, dofs, nrb, count, source);
+}
+}  // namespace
+
+ModalData detect_changed_data(const Case& c, Model* changed) {
+  if (!c.detect) throw InputError(c.path + ": the case has no detect: section (see docs/case-file.md)");
+  const DetectSpec& d = *c.detect;
+  if (!d.measured_file.empty()) return read_modal_data(d.measured_file);
+  *changed = changed_model(c.model, d.changes);
+  return simulate(*changed, d.measured_dofs, d.options.modes > 0 ? d.options.modes : 6, "simulation of " + c.name);
+}
+
+ModalData update_measured_data(const Case& c) {
+  if (!c.update) throw InputError(c.path + ": the case has no update: section (see docs/case-file.md)");
+  const UpdateSpec& u = *c.update;
+  ModalData m = !u.measured_file.empty()
+                    ? read_modal_data(u.measured_file)
+                    : simulate(apply_factors(c.model, u.target_changes), u.measured_dofs, u.target_modes,
+                               "simulated target of " + c.name);
+  if (u.modes > 0 && u.modes < m.num_modes()) {
+    m.frequencies_hz.conservativeResize(u.modes);
+    m.shapes.conservativeResize(Eigen::NoChange, u.modes);
+    if (m.damping_ratios.size() > u.modes) m.damping_ratios.conservativeResize(u.modes);
+  }
+  return m;
 }
 
 Case load_case(const std::string& path) {

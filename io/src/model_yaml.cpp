@@ -393,9 +393,10 @@ Model parse_model(const YAML::Node& node, const YamlCtx& ctx) {
     for (const Element& e : p.model.elements()) p.element_nodes[e.id] = node["generate"];
   } else {
     if (!node["nodes"]) ctx.fail(node, "model: nodes are missing");
-    if (!node["elements"]) ctx.fail(node, "model: elements are missing");
+    if (!node["elements"] && !node["springs"] && !node["point_masses"])
+      ctx.fail(node, "model: elements are missing (or give springs and point_masses for a lumped model)");
     p.parse_nodes(node["nodes"]);
-    p.parse_elements(node["elements"]);
+    if (node["elements"]) p.parse_elements(node["elements"]);
   }
   if (node["point_masses"]) p.parse_point_masses(node["point_masses"]);
   if (node["springs"]) p.parse_springs(node["springs"]);

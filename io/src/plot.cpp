@@ -41,10 +41,11 @@ void draw_panel(const Panel& p, double vx0, double vx1, double vy0, double vy1) 
   for (const Series& s : p.series)
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
       if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i]) || (p.log_y && s.y[i] <= 0)) continue;
-      x0 = std::min(x0, s.x[i]);
-      x1 = std::max(x1, s.x[i]);
-      y0 = std::min(y0, tr(s.y[i], p.log_y));
-      y1 = std::max(y1, tr(s.y[i], p.log_y));
+      x0 = std::min(x0, s.x[i] + s.dx);
+      x1 = std::max(x1, s.x[i] + s.dx);
+      const double e = i < s.yerr.size() && std::isfinite(s.yerr[i]) && !p.log_y ? s.yerr[i] : 0.0;
+      y0 = std::min(y0, tr(s.y[i], p.log_y) - e);
+      y1 = std::max(y1, tr(s.y[i], p.log_y) + e);
     }
   for (const auto& h : p.hlines) {
     if (p.log_y && h.first <= 0) continue;
@@ -55,7 +56,7 @@ void draw_panel(const Panel& p, double vx0, double vx1, double vy0, double vy1) 
   if (!std::isfinite(y0)) y0 = 0, y1 = 1;
   bool bars = false;
   for (const Series& s : p.series) bars = bars || s.kind == Kind::kBars || s.kind == Kind::kStems;
-  if (bars) x0 -= 0.7, x1 += 0.7;
+  if (bars || !p.xticks.empty()) x0 -= 0.7, x1 += 0.7;
   if (x1 == x0) x0 -= 0.5, x1 += 0.5;
   if (y1 == y0) y0 -= 0.5, y1 += 0.5;
   const double dy = y1 - y0;
@@ -138,8 +139,12 @@ void draw_panel(const Panel& p, double vx0, double vx1, double vy0, double vy1) 
     std::vector<PLFLT> xs, ys;
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
       if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
-      xs.push_back(s.x[i]);
+      xs.push_back(s.x[i] + s.dx);
       ys.push_back(p.log_y && s.y[i] <= 0 ? y0 : tr(s.y[i], p.log_y));
+      if (i < s.yerr.size() && std::isfinite(s.yerr[i]) && s.yerr[i] > 0) {
+        PLFLT ex = s.x[i] + s.dx, lo = tr(s.y[i] - s.yerr[i], p.log_y), hi = tr(s.y[i] + s.yerr[i], p.log_y);
+        plerry(1, &ex, &lo, &hi);
+      }
     }
     const PLINT n = static_cast<PLINT>(xs.size());
     const double base = p.log_y ? y0 : std::max(y0, std::min(0.0, y1));

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -37,6 +39,8 @@ struct FitOptions {
   double min_mac = 0.5;           ///< pairing threshold
   int extra_modes = 10;           ///< model modes computed beyond the measured ones (pairing, expansion)
   bool covariance = true;
+  /// Tied parameters: theta[p] = ratio * theta[q] for each (p, (q, ratio)); q must be free, p is not.
+  std::vector<std::pair<int, std::pair<int, double>>> ties;
   bool IsValid(std::string* why) const;
 };
 
@@ -54,6 +58,9 @@ struct FitSummary {
   double initial_cost = 0, final_cost = 0;
   Eigen::VectorXd measured_hz, initial_hz, final_hz;  ///< per measured mode (paired model modes)
   Eigen::VectorXd initial_mac, final_mac;
+  /// sqrt(chi2 / (data - free parameters)) at the solution: 1 when the stated noise is right. `stddev` assumes
+  /// the stated noise; stddev * residual_scale is the a-posteriori estimate when the noise is not known.
+  double residual_scale = std::numeric_limits<double>::quiet_NaN();
   std::vector<int> at_bound;    ///< parameters that ended on a bound
   std::vector<std::string> warnings;
   std::string report;           ///< Ceres FullReport()
@@ -76,6 +83,23 @@ struct Linearization {
 };
 Linearization linearize(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta,
                         const FitOptions& options);
+
+/// The fit's residual vector and cost as functions of the parameters, for other optimisers (the genetic
+/// algorithm baseline in bench/) and for scans. Keeps the eigen-solver's symbolic analysis between calls.
+class FitProblem {
+ public:
+  FitProblem(const ParametricModel& pm, const ModalData& measured, const FitOptions& options);
+  ~FitProblem();
+  /// Whitened residuals at theta (all parameters); false if the model cannot be evaluated there.
+  bool residuals(const Eigen::VectorXd& theta, Eigen::VectorXd* r);
+  /// 1/2 ||r||^2, or +inf where the model cannot be evaluated.
+  double cost(const Eigen::VectorXd& theta);
+  int evaluations() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 /// One evaluation of the model against measured data (no fitting): frequencies and MAC of the paired modes.
 struct Correlation {

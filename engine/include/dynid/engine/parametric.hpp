@@ -13,8 +13,8 @@
 namespace dynid {
 
 /// What a parameter changes. Factors are dimensionless (1 = nominal) and multiply element properties:
-///   kStiffness  E       -> every stiffness part of its elements                 (delta k = theta - 1)
-///   kMass       rho     -> every mass part of its elements                      (delta m = theta - 1)
+///   kStiffness  E       -> every stiffness part of its elements, springs' k     (delta k = theta - 1)
+///   kMass       rho     -> every mass part of its elements, point masses' m     (delta m = theta - 1)
 ///   kArea       A       -> axial stiffness and translational mass
 ///   kInertia    I       -> bending and torsional stiffness, rotary mass
 /// Additive parameters are in the user's units (nominal 0):
@@ -35,6 +35,9 @@ struct Parameter {
   double upper = std::numeric_limits<double>::infinity();
   double scale = 1.0;         ///< typical magnitude (prior std for regularisation; 1 for factors)
 };
+
+/// A copy of `model` with element property factors multiplied (simulated targets: e.g. element 4's rho x 1.2).
+Model apply_factors(const Model& model, const std::vector<std::pair<int, PropertyFactors>>& changes);
 
 class ParametricModel {
  public:

@@ -8,6 +8,8 @@
 #include <optional>
 
 #include "dynid/engine/detect.hpp"
+#include "dynid/engine/model_fit.hpp"
+#include "dynid/engine/parametric.hpp"
 #include "dynid/mesh/model.hpp"
 #include "dynid/solvers/eigen.hpp"
 
@@ -35,6 +37,21 @@ struct DetectSpec {
   NoiseStudyOptions study;
 };
 
+/// What `update:` asks for (docs/case-file.md): parameters, objective, and the measured data (a file, or a
+/// simulated target: the model with element factors changed, sampled at `measured_dofs`).
+struct UpdateSpec {
+  std::string measured_file;
+  std::vector<std::pair<int, PropertyFactors>> target_changes;  ///< simulated target
+  std::vector<MeasuredDof> measured_dofs;
+  int target_modes = 5;                  ///< elastic modes of the simulated target
+  int modes = 0;                         ///< measured modes used (0 = all)
+  std::vector<Parameter> parameters;     ///< resolved against the model (element indices)
+  Eigen::VectorXd initial;
+  std::vector<char> free;
+  std::vector<std::pair<int, std::pair<int, double>>> ties;
+  FitOptions options;
+};
+
 struct Case {
   std::string path;         ///< the case file
   std::string dir;          ///< its folder (relative paths in the case resolve against it)
@@ -42,6 +59,7 @@ struct Case {
   Model model;              ///< finalized
   AnalysisSpec analysis;
   std::optional<DetectSpec> detect;
+  std::optional<UpdateSpec> update;
 };
 
 /// Loads a case from a case file, or from a folder holding case.yaml / case.yml / case.json.
@@ -50,6 +68,12 @@ Case load_case(const std::string& path);
 
 /// Parses a case from text (for tests and host codes); `name` is used in messages as the file name.
 Case parse_case(const std::string& text, const std::string& name, const std::string& dir = ".");
+
+/// The changed state of a detect: case: measured data from its file, or the exact modes of the changed model at
+/// the measured DOFs (then *changed receives that model, for DetectOptions::simulated_changed).
+ModalData detect_changed_data(const Case& c, Model* changed);
+/// The measured data of an update: case: from its file, or the simulated target; the first `modes` modes.
+ModalData update_measured_data(const Case& c);
 
 /// Resolves a CASE argument (file or folder) to the case file path; throws InputError if there is none.
 std::string resolve_case_path(const std::string& path);

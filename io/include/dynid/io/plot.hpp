@@ -17,6 +17,8 @@ struct Series {
   int color = -1;        ///< palette index 0..9 (-1: next in the panel)
   double width = 1.6;    ///< line width
   double bar_width = 0.8;
+  std::vector<double> yerr;  ///< optional symmetric error bars (one per point; NaN = none)
+  double dx = 0;             ///< horizontal offset (to place grouped markers side by side)
 };
 
 struct Panel {

@@ -1,0 +1,176 @@
+// dynid update CASE [--json FILE] [--plot FILE]: FE model updating with Ceres.
+#include <fmt/core.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "commands.hpp"
+#include "dynid/engine/model_fit.hpp"
+#include "dynid/io/case_file.hpp"
+#include "dynid/io/modal_data_io.hpp"
+#include "dynid/io/output.hpp"
+#include "dynid/io/plot.hpp"
+#include "dynid/mesh/error.hpp"
+#include "progress.hpp"
+
+namespace dynid::cli {
+
+namespace {
+
+struct UpdateArgs {
+  std::string case_path, json, plot;
+  bool force = false;
+};
+
+std::vector<double> vec(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+
+nlohmann::json update_json(const Case& c, const ParametricModel& pm, const UpdateSpec& u, const FitSummary& f) {
+  auto num = [](double v) { return std::isnan(v) ? nlohmann::json() : nlohmann::json(v); };
+  nlohmann::json params = nlohmann::json::array();
+  for (int p = 0; p < pm.num_parameters(); ++p) {
+    const Parameter& q = pm.parameter(p);
+    std::string status = u.free[p] ? "free" : "fixed";
+    for (const auto& t : u.ties)
+      if (t.first == p) status = "tied to " + pm.parameter(t.second.first).name;
+    params.push_back({{"name", q.name},
+                      {"kind", std::string(parameter_kind_name(q.kind))},
+                      {"initial", u.initial[p]},
+                      {"value", f.theta[p]},
+                      {"std", num(f.stddev[p])},
+                      {"std_aposteriori", num(f.stddev[p] * f.residual_scale)},
+                      {"status", status},
+                      {"at_bound", std::find(f.at_bound.begin(), f.at_bound.end(), p) != f.at_bound.end()}});
+  }
+  nlohmann::json j;
+  j["case"] = c.name;
+  j["parameters"] = params;
+  j["frequencies_hz"] = {{"initial", vec(f.initial_hz)}, {"updated", vec(f.final_hz)}, {"measured", vec(f.measured_hz)}};
+  j["mac"] = {{"initial", vec(f.initial_mac)}, {"updated", vec(f.final_mac)}};
+  j["objective"] = std::string(fit_objective_name(u.options.objective));
+  j["iterations"] = f.iterations;
+  j["model_evaluations"] = f.evaluations;
+  j["cost"] = {{"initial", f.initial_cost}, {"final", f.final_cost}, {"history", f.cost_history}};
+  j["termination"] = f.termination;
+  j["converged"] = f.converged;
+  j["covariance"] = {{"rank", f.covariance_rank}, {"free_parameters", f.free_parameters}, {"full_rank", f.covariance_ok},
+                     {"residual_scale", num(f.residual_scale)}};
+  j["warnings"] = f.warnings;
+  return j;
+}
+
+plot::Figure update_figure(const Case& c, const ParametricModel& pm, const UpdateSpec& u, const FitSummary& f) {
+  plot::Figure fig;
+  fig.title = "dynid update: " + c.name + " (objective " + std::string(fit_objective_name(u.options.objective)) + ")";
+  fig.rows = 3;
+  fig.height = 1300;
+  plot::Panel p1, p2, p3;
+  p1.title = "Frequency error against the measured modes";
+  p1.ylabel = "frequency error [%]";
+  p1.xlabel = "measured mode";
+  plot::Series s0, s1;
+  s0.label = "initial model";
+  s1.label = "updated model";
+  s0.kind = s1.kind = plot::Kind::kBars;
+  s0.bar_width = s1.bar_width = 0.35;
+  s0.color = 1;
+  s1.color = 0;
+  s0.dx = -0.2;
+  s1.dx = 0.2;
+  for (Eigen::Index k = 0; k < f.measured_hz.size(); ++k) {
+    s0.x.push_back(k + 1);
+    s1.x.push_back(k + 1);
+    s0.y.push_back(100 * (f.initial_hz[k] - f.measured_hz[k]) / f.measured_hz[k]);
+    s1.y.push_back(100 * (f.final_hz[k] - f.measured_hz[k]) / f.measured_hz[k]);
+  }
+  p1.series = {s0, s1};
+  p1.hlines = {{0.0, ""}};
+  p2.title = "MAC of the paired modes";
+  p2.ylabel = "MAC";
+  p2.xlabel = "measured mode";
+  plot::Series m0 = s0, m1 = s1;
+  m0.y.clear();
+  m1.y.clear();
+  for (Eigen::Index k = 0; k < f.measured_hz.size(); ++k) {
+    m0.y.push_back(f.initial_mac[k]);
+    m1.y.push_back(f.final_mac[k]);
+  }
+  p2.series = {m0, m1};
+  p2.ymin = 0;
+  p2.ymax = 1.05;
+  p3.title = "Parameters (updated value with one standard deviation)";
+  p3.ylabel = "value (factor 1 = nominal)";
+  plot::Series v0, v1;
+  v0.label = "initial";
+  v1.label = "updated";
+  v0.kind = v1.kind = plot::Kind::kMarkers;
+  v0.color = 1;
+  v1.color = 0;
+  for (int p = 0; p < pm.num_parameters(); ++p) {
+    v0.x.push_back(p + 1);
+    v1.x.push_back(p + 1);
+    v0.y.push_back(u.initial[p]);
+    v1.y.push_back(f.theta[p]);
+    v1.yerr.push_back(f.stddev[p]);
+    p3.xticks.push_back({static_cast<double>(p + 1), pm.parameter(p).name});
+  }
+  p3.series = {v0, v1};
+  fig.panels = {p1, p2, p3};
+  return fig;
+}
+
+int run_update(const UpdateArgs& a, const GlobalOptions& g) {
+  set_threads(g.threads);
+  const Case c = load_case(a.case_path);
+  if (!c.update) throw InputError(c.path + ": the case has no update: section (see docs/case-file.md)");
+  const UpdateSpec& u = *c.update;
+  Progress progress(!g.quiet);
+  progress.update("measured data", -1);
+  const ModalData measured = update_measured_data(c);
+  ParametricModel pm(c.model);
+  for (const Parameter& p : u.parameters) pm.add(p);
+  progress.update("updating", -1);
+  const FitSummary f = fit_parameters(pm, measured, u.initial, u.free, u.options);
+  progress.done();
+  if (!g.quiet) {
+    fmt::print("dynid update: {} — {} parameters ({} free), {} measured modes at {} DOFs, objective {}\n", c.name,
+               pm.num_parameters(), f.free_parameters, measured.num_modes(), measured.dofs.size(),
+               fit_objective_name(u.options.objective));
+    fmt::print("  Ceres: {} iterations, {} model evaluations, cost {:.4g} -> {:.4g}, {}\n", f.iterations, f.evaluations,
+               f.initial_cost, f.final_cost, f.termination);
+    fmt::print("  parameter            initial      updated      std (stated noise)  std (a posteriori, x{:.3g})\n",
+               f.residual_scale);
+    for (int p = 0; p < pm.num_parameters(); ++p)
+      fmt::print("  {:<18}  {:<11.6g}  {:<11.6g}  {:<18}  {}\n", pm.parameter(p).name, u.initial[p], f.theta[p],
+                 std::isnan(f.stddev[p]) ? std::string("-") : fmt::format("{:.3g}", f.stddev[p]),
+                 std::isnan(f.stddev[p] * f.residual_scale) ? std::string("-")
+                                                            : fmt::format("{:.3g}", f.stddev[p] * f.residual_scale));
+    fmt::print("  mode  measured Hz  initial Hz (err %)    updated Hz (err %)    MAC initial  MAC updated\n");
+    for (Eigen::Index k = 0; k < f.measured_hz.size(); ++k)
+      fmt::print("  {:4d}  {:<11.6g}  {:<10.6g} ({:+7.3f})  {:<10.6g} ({:+7.3f})  {:<11.4f}  {:.4f}\n", k + 1,
+                 f.measured_hz[k], f.initial_hz[k], 100 * (f.initial_hz[k] / f.measured_hz[k] - 1), f.final_hz[k],
+                 100 * (f.final_hz[k] / f.measured_hz[k] - 1), f.initial_mac[k], f.final_mac[k]);
+    for (const std::string& w : f.warnings) fmt::print(stderr, "dynid update: warning: {}\n", w);
+  }
+  if (!a.json.empty()) {
+    write_file_atomic(a.json, update_json(c, pm, u, f).dump(1) + "\n", a.force);
+    const std::string png = a.plot.empty() ? std::filesystem::path(a.json).replace_extension(".png").string() : a.plot;
+    plot::save(update_figure(c, pm, u, f), png, a.force);
+  } else if (!a.plot.empty()) {
+    plot::save(update_figure(c, pm, u, f), a.plot, a.force);
+  }
+  return f.converged ? 0 : 1;
+}
+
+}  // namespace
+
+void register_update(CLI::App& app, GlobalOptions& g) {
+  auto a = std::make_shared<UpdateArgs>();
+  CLI::App* cmd = app.add_subcommand("update", "FE model updating: fit physical parameters to measured modes (Ceres)");
+  cmd->add_option("CASE", a->case_path, "Case file or folder with an update: section")->required();
+  cmd->add_option("--json", a->json, "Write the results as JSON to FILE (and the plot beside it, FILE.png)");
+  cmd->add_option("--plot", a->plot, "Write the plot (frequency errors, MAC, parameters) to FILE (.png or .svg)");
+  cmd->add_flag("--force", a->force, "Overwrite existing output files");
+  cmd->callback([a, &g]() { g.exit_code = run_guarded("update", [&] { return run_update(*a, g); }); });
+}
+
+}  // namespace dynid::cli

@@ -1,0 +1,27 @@
+// Helpers shared by the case-file sections (internal to io).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "dynid/engine/modal_data.hpp"
+#include "internal/yaml_util.hpp"
+
+namespace dynid::internal {
+
+/// measured_dofs: all | translations | {types: [ux, uy], nodes: [...]} | [13ux, 13uy, ...]
+std::vector<MeasuredDof> parse_dof_selection(const YAML::Node& n, const YamlCtx& ctx, const Model& model,
+                                             const std::string& what);
+/// A path relative to the case file's folder (absolute paths unchanged).
+std::string resolve(const std::string& dir, const std::string& file);
+
+}  // namespace dynid::internal
+
+#include "dynid/io/case_file.hpp"
+
+namespace dynid::internal {
+
+/// The `update:` section (io/src/case_update.cpp).
+UpdateSpec parse_update(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir);
+
+}  // namespace dynid::internal
