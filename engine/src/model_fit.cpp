@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -98,11 +99,25 @@ class Evaluator {
     m_serep_ = std::min<int>(static_cast<int>(rows_.size()), eo.num_modes);
   }
 
+  // Bounds are enforced by projection: a value outside [lower, upper] is evaluated at the bound (and its
+  // derivative is zero there, see jacobians()). Ceres' own bound handling would add a projected line search
+  // with a Jacobian evaluation - an eigen-solve and sensitivities - at every step.
   Eigen::VectorXd theta_of(const double* x) const {
     Eigen::VectorXd t = theta0_;
     for (std::size_t k = 0; k < xmap_.size(); ++k)
-      for (const auto& [p, c] : xmap_[k]) t[p] = c * x[k];
+      for (const auto& [p, c] : xmap_[k]) {
+        const Parameter& q = pm_.parameter(p);
+        t[p] = std::min(std::max(c * x[k], q.lower), q.upper);
+      }
     return t;
+  }
+  // Whether x_f's value is clamped at a bound (for one of the parameters it drives).
+  bool clamped(std::size_t f, double xf) const {
+    for (const auto& [p, c] : xmap_[f]) {
+      const Parameter& q = pm_.parameter(p);
+      if (c * xf < q.lower || c * xf > q.upper) return true;
+    }
+    return false;
   }
   // Column of dr/dx_f from the parameter columns: sum over the parameters x_f drives.
   template <class Col>
@@ -119,6 +134,8 @@ class Evaluator {
     }
   }
   int evaluations() const { return evaluations_; }
+  double time_eigen() const { return time_eigen_; }
+  double time_sensitivity() const { return time_sens_; }
   const std::vector<int>& rows() const { return rows_; }
 
   const Evaluation& at(const double* x, bool jacobian) {
@@ -129,7 +146,14 @@ class Evaluator {
       cached_ = true;
       solve(theta_of(x));
     }
-    if (jacobian && ev_.ok && !ev_.has_jacobian) jacobians();
+    if (jacobian && ev_.ok && !ev_.has_jacobian) {
+      const auto t0 = std::chrono::steady_clock::now();
+      jacobians();
+      time_sens_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      for (std::size_t f = 0; f < free_.size(); ++f)
+        if (clamped(f, x[f]))
+          for (auto& J : ev_.J) J.col(static_cast<Eigen::Index>(f)).setZero();
+    }
     return ev_;
   }
 
@@ -137,9 +161,19 @@ class Evaluator {
   void solve(const Eigen::VectorXd& theta) {
     ev_ = Evaluation{};
     ++evaluations_;
+    const auto t0 = std::chrono::steady_clock::now();
     SparseMatrix K, M;
     pm_.matrices(theta, &K, &M);
     EigenSolution s = solver_.solve(K, M);
+    // Every measured mode must be in reach of the pairing: compute modes until the highest measured frequency is
+    // exceeded by 10 % (measured modes need not be the lowest ones: sensors miss local modes).
+    const double need = hz_to_eigenvalue(1.1 * meas_.frequencies_hz.maxCoeff());
+    while (!complete_ && s.summary.ok() && s.eigenvalues.size() > 0 && s.eigenvalues.maxCoeff() < need &&
+           solver_.options().num_modes < pm_.model().num_dofs() - 1) {
+      solver_.options().num_modes = std::min(pm_.model().num_dofs() - 1, solver_.options().num_modes * 3 / 2 + 10);
+      s = solver_.solve(K, M);
+    }
+    time_eigen_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!s.summary.ok()) {
       ev_.error = s.summary.message;
       return;
@@ -328,29 +362,33 @@ class Evaluator {
   bool cached_ = false;
   Evaluation ev_;
   int evaluations_ = 0;
+  double time_eigen_ = 0, time_sens_ = 0;
 };
 
+// Rows [first, first + count) of measured mode k's residual block (its frequency, or its shape), so that a
+// robust loss acts on each separately: a bad frequency does not silence a good shape.
 class ModeCost : public ceres::CostFunction {
  public:
-  ModeCost(std::shared_ptr<Evaluator> ev, int k, int nres, int nfree) : ev_(std::move(ev)), k_(k) {
-    set_num_residuals(nres);
+  ModeCost(std::shared_ptr<Evaluator> ev, int k, int first, int count, int nfree)
+      : ev_(std::move(ev)), k_(k), first_(first) {
+    set_num_residuals(count);
     mutable_parameter_block_sizes()->push_back(nfree);
   }
   bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
     const bool want = jacobians != nullptr && jacobians[0] != nullptr;
     const Evaluation& e = ev_->at(params[0], want);
     if (!e.ok) return false;
-    Eigen::Map<Eigen::VectorXd>(residuals, num_residuals()) = e.r[k_];
+    Eigen::Map<Eigen::VectorXd>(residuals, num_residuals()) = e.r[k_].segment(first_, num_residuals());
     if (want) {
       Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-          jacobians[0], num_residuals(), parameter_block_sizes()[0]) = e.J[k_];
+          jacobians[0], num_residuals(), parameter_block_sizes()[0]) = e.J[k_].middleRows(first_, num_residuals());
     }
     return true;
   }
 
  private:
   std::shared_ptr<Evaluator> ev_;
-  int k_;
+  int k_, first_;
 };
 
 // Tikhonov regularisation toward the nominal values: sqrt(w) (theta_p - nominal_p) / scale_p.
@@ -422,6 +460,7 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
     if (!(theta0[p] >= q.lower && theta0[p] <= q.upper))
       throw InputError("fit: start value of parameter '" + q.name + "' is outside its bounds");
   }
+  const auto t_start = std::chrono::steady_clock::now();
   auto ev = std::make_shared<Evaluator>(pm, measured, theta0, free, o);
   const int nf = static_cast<int>(free.size());
   std::vector<double> x(free.size());
@@ -439,12 +478,20 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
   po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
   po.loss_function_ownership = ceres::TAKE_OWNERSHIP;
   ceres::Problem problem(po);
-  for (int k = 0; k < measured.num_modes(); ++k) {
-    ceres::LossFunction* loss = nullptr;
+  auto make_loss = [&]() -> ceres::LossFunction* {
     const double s2 = o.loss_scale * o.loss_scale;
-    if (o.loss == FitOptions::Loss::kHuber) loss = new ceres::HuberLoss(s2);
-    if (o.loss == FitOptions::Loss::kCauchy) loss = new ceres::CauchyLoss(s2);
-    problem.AddResidualBlock(new ModeCost(ev, k, ev->rows_per_mode(), nf), loss, x.data());
+    if (o.loss == FitOptions::Loss::kHuber) return new ceres::HuberLoss(s2);
+    if (o.loss == FitOptions::Loss::kCauchy) return new ceres::CauchyLoss(s2);
+    return nullptr;
+  };
+  const int rows = ev->rows_per_mode();
+  for (int k = 0; k < measured.num_modes(); ++k) {
+    if (o.objective == FitObjective::kCombined) {  // frequency and shape as separate blocks
+      problem.AddResidualBlock(new ModeCost(ev, k, 0, 1, nf), make_loss(), x.data());
+      problem.AddResidualBlock(new ModeCost(ev, k, 1, rows - 1, nf), make_loss(), x.data());
+    } else {
+      problem.AddResidualBlock(new ModeCost(ev, k, 0, rows, nf), make_loss(), x.data());
+    }
   }
   if (o.regularization > 0) {
     Eigen::VectorXd nom(nf), w(nf);
@@ -453,11 +500,6 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
       w[k] = std::sqrt(o.regularization) / pm.parameter(free[k]).scale;
     }
     problem.AddResidualBlock(new PriorCost(nom, w), nullptr, x.data());
-  }
-  for (int k = 0; k < nf; ++k) {
-    const Parameter& q = pm.parameter(free[k]);
-    if (std::isfinite(q.lower)) problem.SetParameterLowerBound(x.data(), k, q.lower);
-    if (std::isfinite(q.upper)) problem.SetParameterUpperBound(x.data(), k, q.upper);
   }
   ceres::Solver::Options so;
   so.trust_region_strategy_type = o.dogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
@@ -481,6 +523,7 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
   out.final_cost = sum.final_cost;
   out.report = sum.FullReport();
   out.theta = ev->theta_of(x.data());
+  for (int k = 0; k < nf; ++k) x[k] = out.theta[free[k]];  // the projected (evaluated) values
 
   const Evaluation& ef = ev->at(x.data(), true);
   if (!ef.ok) throw NumericalError("fit: the model cannot be evaluated at the solution: " + ef.error);
@@ -550,6 +593,9 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
     }
   }
   out.evaluations = ev->evaluations();
+  out.time_eigen = ev->time_eigen();
+  out.time_sensitivity = ev->time_sensitivity();
+  out.time_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return out;
 }
 

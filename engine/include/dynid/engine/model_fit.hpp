@@ -31,11 +31,14 @@ struct FitOptions {
   double shape_noise = 1e-2;      ///< std of shape entries relative to each mode's largest entry
   double regularization = 0.0;    ///< Tikhonov weight w: residuals sqrt(w) (theta_p - nominal_p) / scale_p
   enum class Loss { kNone, kHuber, kCauchy };
-  Loss loss = Loss::kNone;        ///< robust loss per measured mode, on the whitened residual
+  Loss loss = Loss::kNone;        ///< robust loss on each mode's frequency residual and, separately, its shape
+                                  ///< residuals (whitened)
   double loss_scale = 3.0;        ///< in units of the noise std
   bool dogleg = false;            ///< trust-region dogleg instead of Levenberg-Marquardt
   int max_iterations = 100;
-  double function_tolerance = 1e-12, parameter_tolerance = 1e-10, gradient_tolerance = 1e-14;
+  /// Ceres stopping tests: relative cost change (1e-8: far below a significant chi-square change when the data
+  /// are noisy), relative step (exact data converge here) and gradient.
+  double function_tolerance = 1e-8, parameter_tolerance = 1e-10, gradient_tolerance = 1e-14;
   double min_mac = 0.5;           ///< pairing threshold
   int extra_modes = 10;           ///< model modes computed beyond the measured ones (pairing, expansion)
   bool covariance = true;
@@ -53,6 +56,9 @@ struct FitSummary {
   std::vector<double> cost_history;  ///< Ceres cost (1/2 sum r^2) per iteration, starting with the initial
   int iterations = 0;
   int evaluations = 0;          ///< model evaluations (eigen-solves)
+  double time_eigen = 0;        ///< seconds in eigen-solves
+  double time_sensitivity = 0;  ///< seconds in sensitivities (Jacobians)
+  double time_total = 0;        ///< seconds in fit_parameters
   std::string termination;      ///< Ceres termination: CONVERGENCE, NO_CONVERGENCE, FAILURE, ...
   bool converged = false;
   double initial_cost = 0, final_cost = 0;
