@@ -18,6 +18,13 @@ void ModalData::validate(const std::string& what) const {
                      std::to_string(dofs.size()) + " DOFs");
   if (damping_ratios.size() != 0 && damping_ratios.size() != m)
     throw InputError(what + ": " + std::to_string(damping_ratios.size()) + " damping ratios for " + std::to_string(m) + " modes");
+  auto optional = [&](const Eigen::VectorXd& v, const char* name) {
+    if (v.size() != 0 && v.size() != m)
+      throw InputError(what + ": " + std::to_string(v.size()) + " " + name + " values for " + std::to_string(m) + " modes");
+  };
+  optional(mpc, "MPC");
+  optional(frequency_std_hz, "frequency standard deviation");
+  optional(damping_std, "damping standard deviation");
   for (Eigen::Index k = 0; k < m; ++k) {
     if (!std::isfinite(frequencies_hz[k]) || frequencies_hz[k] <= 0)
       throw InputError(what + ": mode " + std::to_string(k + 1) + " has frequency " + std::to_string(frequencies_hz[k]) +

@@ -88,12 +88,17 @@ ModalData parse_modal_data_json(const std::string& text, const std::string& name
     }
     d.frequencies_hz[static_cast<Eigen::Index>(k)] = m["frequency_hz"].get<double>();
   }
-  bool damping = true;
-  for (const auto& m : modes) damping = damping && m.contains("damping_ratio") && m["damping_ratio"].is_number();
-  if (damping) {
-    d.damping_ratios.resize(static_cast<Eigen::Index>(modes.size()));
-    for (std::size_t k = 0; k < modes.size(); ++k) d.damping_ratios[static_cast<Eigen::Index>(k)] = modes[k]["damping_ratio"].get<double>();
-  }
+  // Optional per-mode numbers: kept only when every mode gives them.
+  auto optional = [&](const char* key, Eigen::VectorXd* v) {
+    for (const auto& m : modes)
+      if (!m.contains(key) || !m[key].is_number()) return;
+    v->resize(static_cast<Eigen::Index>(modes.size()));
+    for (std::size_t k = 0; k < modes.size(); ++k) (*v)[static_cast<Eigen::Index>(k)] = modes[k][key].get<double>();
+  };
+  optional("damping_ratio", &d.damping_ratios);
+  optional("mpc", &d.mpc);
+  optional("frequency_std_hz", &d.frequency_std_hz);
+  optional("damping_std", &d.damping_std);
   d.validate(name);
   return d;
 }
@@ -112,6 +117,9 @@ nlohmann::ordered_json modal_data_json(const ModalData& d) {
     nlohmann::ordered_json m;
     m["frequency_hz"] = d.frequencies_hz[k];
     if (d.damping_ratios.size() == d.frequencies_hz.size()) m["damping_ratio"] = d.damping_ratios[k];
+    if (d.frequency_std_hz.size() == d.frequencies_hz.size()) m["frequency_std_hz"] = d.frequency_std_hz[k];
+    if (d.damping_std.size() == d.frequencies_hz.size()) m["damping_std"] = d.damping_std[k];
+    if (d.mpc.size() == d.frequencies_hz.size()) m["mpc"] = d.mpc[k];
     nlohmann::ordered_json sh = nlohmann::ordered_json::object();
     for (std::size_t r = 0; r < d.dofs.size(); ++r) sh[to_string(d.dofs[r])] = d.shapes(static_cast<Eigen::Index>(r), k);
     m["shape"] = sh;

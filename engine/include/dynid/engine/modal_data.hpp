@@ -24,6 +24,9 @@ struct ModalData {
   Eigen::VectorXd frequencies_hz;  ///< one per mode (column of `shapes`)
   Eigen::MatrixXd shapes;          ///< dofs x modes
   Eigen::VectorXd damping_ratios;  ///< optional (empty or one per mode)
+  Eigen::VectorXd mpc;             ///< optional modal phase collinearity of identified modes (1 = real mode)
+  Eigen::VectorXd frequency_std_hz;  ///< optional standard deviation of each frequency (identification)
+  Eigen::VectorXd damping_std;       ///< optional standard deviation of each damping ratio
   std::string source;              ///< where it came from (file, "simulation of ...")
   int num_modes() const { return static_cast<int>(frequencies_hz.size()); }
   /// Throws InputError if sizes disagree or values are not finite / frequencies not positive.
