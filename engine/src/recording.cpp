@@ -60,8 +60,9 @@ void FrfData::validate(const std::string& what) const {
   if (!frequency_hz.allFinite() || frequency_hz[0] < 0) throw InputError(what + ": frequencies must be finite and >= 0");
   for (Eigen::Index c = 0; c < H.cols(); ++c)
     if (!H.col(c).allFinite()) throw InputError(what + ": FRF " + std::to_string(c + 1) + " holds NaN or Inf values");
-  if (coherence.size() != 0 && (coherence.rows() != nf || coherence.cols() != static_cast<Eigen::Index>(outputs.size())))
-    throw InputError(what + ": coherence must be frequencies x outputs");
+  if (coherence.size() != 0 && (coherence.rows() != nf || coherence.cols() != H.cols()))
+    throw InputError(what + ": coherence must have the shape of the FRF matrix");
+  if (!(window_decay >= 0)) throw InputError(what + ": window decay must be >= 0");
 }
 
 }  // namespace dynid

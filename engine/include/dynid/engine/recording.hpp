@@ -43,14 +43,17 @@ struct Recording {
 };
 
 /// Frequency response functions H(f) = output / input on a common frequency grid.
-/// Column o + i * outputs.size() of `H` is output o over input i; `coherence` (optional, frequencies x outputs)
-/// is the (multiple) coherence of each output.
+/// Column o + i * outputs.size() of `H` is output o over input i; `coherence` (optional) has the same layout
+/// (for several simultaneous inputs, the multiple coherence of output o, repeated over those inputs).
 struct FrfData {
   Eigen::VectorXd frequency_hz;
   std::vector<Channel> outputs;   ///< response DOFs and their quantity (receptance/mobility/accelerance)
   std::vector<Channel> inputs;    ///< excitation DOFs
   Eigen::MatrixXcd H;             ///< frequencies x (outputs * inputs)
-  Eigen::MatrixXd coherence;      ///< empty, or frequencies x outputs
+  Eigen::MatrixXd coherence;      ///< empty, or the shape of H
+  /// Decay rate 1/tau (1/s) of an exponential window applied to the time data before the FRF was formed: it
+  /// adds 1/tau to every pole's decay rate, and identification takes it off again.
+  double window_decay = 0;
   std::string source;
 
   int num_outputs() const { return static_cast<int>(outputs.size()); }

@@ -1,0 +1,441 @@
+#include "dynid/engine/identify.hpp"
+
+#include <Eigen/Dense>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "dynid/engine/frf.hpp"
+#include "dynid/mesh/error.hpp"
+#include "dynid/solvers/signal.hpp"
+
+namespace dynid {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+using Clock = std::chrono::steady_clock;
+
+// A pole of one model order with the vector the stability check compares (participation or shape).
+struct RawPole {
+  std::complex<double> lambda;  // continuous time, rad/s, Im > 0
+  Eigen::VectorXcd vec;
+};
+
+double pole_hz(std::complex<double> l) { return std::abs(l) / (2 * kPi); }
+double pole_zeta(std::complex<double> l) { return -l.real() / std::abs(l); }
+
+double complex_mac(const Eigen::VectorXcd& a, const Eigen::VectorXcd& b) {
+  const double d = a.squaredNorm() * b.squaredNorm();
+  return d > 0 ? std::norm(a.dot(b)) / d : 0.0;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double stddev(const std::vector<double>& v) {
+  if (v.size() < 2) return 0;
+  double m = 0, s = 0;
+  for (double x : v) m += x;
+  m /= static_cast<double>(v.size());
+  for (double x : v) s += (x - m) * (x - m);
+  return std::sqrt(s / static_cast<double>(v.size() - 1));
+}
+
+// Stabilization diagram and automatic selection. `orders[j]` holds the poles found at model order `order_of[j]`.
+// Returns, per selected mode, the (order index, pole index) of the pole nearest the cluster's median frequency.
+std::vector<std::pair<int, int>> stabilize_and_select(const std::vector<std::vector<RawPole>>& orders, const std::vector<int>& order_of,
+                                                      double lo, double hi, const IdentificationOptions& o,
+                                                      IdentificationSummary& s) {
+  std::vector<std::pair<int, int>> where;  // pole index in s.poles -> (j, p)
+  for (std::size_t j = 0; j < orders.size(); ++j)
+    for (std::size_t p = 0; p < orders[j].size(); ++p) {
+      const RawPole& rp = orders[j][p];
+      StabilizationPole sp;
+      sp.order = order_of[j];
+      sp.frequency_hz = pole_hz(rp.lambda);
+      sp.damping_ratio = pole_zeta(rp.lambda);
+      sp.physical = sp.frequency_hz >= lo && sp.frequency_hz <= hi && sp.damping_ratio > 0 && sp.damping_ratio < o.max_damping;
+      if (j > 0 && !orders[j - 1].empty()) {
+        const RawPole* best = nullptr;
+        double bd = 1e300;
+        for (const RawPole& q : orders[j - 1]) {
+          const double d = std::abs(pole_hz(q.lambda) - sp.frequency_hz);
+          if (d < bd) bd = d, best = &q;
+        }
+        const double zq = pole_zeta(best->lambda);
+        sp.stable_frequency = bd <= o.stable_frequency * sp.frequency_hz;
+        sp.stable_damping = std::abs(zq - sp.damping_ratio) <= o.stable_damping * std::max(std::abs(sp.damping_ratio), 1e-12);
+        sp.stable_vector = rp.vec.size() <= 1 || complex_mac(rp.vec, best->vec) >= o.stable_mac;
+      }
+      s.poles.push_back(sp);
+      where.emplace_back(static_cast<int>(j), static_cast<int>(p));
+    }
+  // Candidates: physical and stable in every sense; clusters by chained relative frequency gaps.
+  std::vector<int> cand;
+  for (std::size_t i = 0; i < s.poles.size(); ++i)
+    if (s.poles[i].physical && s.poles[i].stable()) cand.push_back(static_cast<int>(i));
+  std::sort(cand.begin(), cand.end(), [&](int a, int b) { return s.poles[a].frequency_hz < s.poles[b].frequency_hz; });
+  std::vector<std::vector<int>> clusters;
+  for (int i : cand) {
+    if (!clusters.empty()) {
+      const StabilizationPole& last = s.poles[clusters.back().back()];
+      if (s.poles[i].frequency_hz - last.frequency_hz <= o.cluster_tolerance * s.poles[i].frequency_hz) {
+        clusters.back().push_back(i);
+        continue;
+      }
+    }
+    clusters.push_back({i});
+  }
+  const double needed = o.min_cluster_fraction * static_cast<double>(orders.size());
+  std::vector<std::pair<int, int>> chosen;
+  for (const std::vector<int>& c : clusters) {
+    std::vector<int> ords;
+    std::vector<double> f, z;
+    for (int i : c) {
+      ords.push_back(s.poles[i].order);
+      f.push_back(s.poles[i].frequency_hz);
+      z.push_back(s.poles[i].damping_ratio);
+    }
+    std::sort(ords.begin(), ords.end());
+    const int distinct = static_cast<int>(std::unique(ords.begin(), ords.end()) - ords.begin());
+    if (distinct < needed) continue;
+    IdentifiedMode m;
+    m.frequency_hz = median(f);
+    m.damping_ratio = median(z);
+    m.frequency_std_hz = stddev(f);
+    m.damping_std = stddev(z);
+    m.poles = distinct;
+    int rep = c[0];
+    for (int i : c)
+      if (std::abs(s.poles[i].frequency_hz - m.frequency_hz) < std::abs(s.poles[rep].frequency_hz - m.frequency_hz)) rep = i;
+    for (int i : c) s.poles[i].cluster = static_cast<int>(s.modes.size());
+    s.modes.push_back(m);
+    chosen.push_back(where[rep]);
+  }
+  return chosen;
+}
+
+void finish_shape(IdentifiedMode& m) {
+  m.mpc = modal_phase_collinearity(m.shape);
+  m.real_shape = real_normalize(m.shape);
+}
+
+// LSFD: residues of every FRF column at fixed poles, with lower (mass-line) and upper (constant) residuals, on
+// receptance data. Returns one row per mode, columns = FRF columns.
+Eigen::MatrixXcd lsfd(const Eigen::VectorXd& w, const Eigen::MatrixXcd& H, const std::vector<std::complex<double>>& poles) {
+  const Eigen::Index nf = w.size(), nm = static_cast<Eigen::Index>(poles.size()), np = 2 * nm + 2;
+  Eigen::MatrixXcd B(nf, np);
+  const std::complex<double> I(0, 1);
+  for (Eigen::Index k = 0; k < nf; ++k) {
+    const std::complex<double> s = I * w[k];
+    for (Eigen::Index r = 0; r < nm; ++r) {
+      const std::complex<double> a = 1.0 / (s - poles[r]), b = 1.0 / (s - std::conj(poles[r]));
+      B(k, 2 * r) = a + b;
+      B(k, 2 * r + 1) = I * a - I * b;
+    }
+    B(k, np - 2) = -1.0 / (w[k] * w[k]);
+    B(k, np - 1) = 1.0;
+  }
+  Eigen::MatrixXd A(2 * nf, np), rhs(2 * nf, H.cols());
+  A << B.real(), B.imag();
+  rhs << H.real(), H.imag();
+  const Eigen::VectorXd scale = A.colwise().norm().cwiseMax(1e-300).cwiseInverse();
+  const Eigen::MatrixXd x = (A * scale.asDiagonal()).colPivHouseholderQr().solve(rhs);
+  Eigen::MatrixXcd R(nm, H.cols());
+  for (Eigen::Index r = 0; r < nm; ++r)
+    for (Eigen::Index c = 0; c < H.cols(); ++c)
+      R(r, c) = {scale[2 * r] * x(2 * r, c), scale[2 * r + 1] * x(2 * r + 1, c)};
+  return R;
+}
+
+void check_band(const IdentificationOptions& o) {
+  std::string why;
+  if (!o.IsValid(&why)) throw InputError("identification: " + why);
+}
+}  // namespace
+
+bool IdentificationOptions::IsValid(std::string* why) const {
+  auto fail = [&](const char* m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (band_lo_hz < 0 || band_hi_hz < 0 || (band_hi_hz > 0 && band_hi_hz <= band_lo_hz)) return fail("the band must satisfy 0 <= lo < hi");
+  if (min_order < 0 || max_order < 0 || (max_order > 0 && max_order < std::max(min_order, 2))) return fail("orders must satisfy 2 <= min <= max");
+  if (max_order > 400) return fail("the maximum order is limited to 400");
+  if (order_step < 0) return fail("the order step must be >= 0");
+  if (!(stable_frequency > 0 && stable_damping > 0 && stable_mac > 0 && stable_mac <= 1)) return fail("stability tolerances must be > 0 (MAC <= 1)");
+  if (!(max_damping > 0 && max_damping < 1)) return fail("the damping limit must be in (0, 1)");
+  if (!(min_cluster_fraction > 0 && min_cluster_fraction <= 1)) return fail("the cluster fraction must be in (0, 1]");
+  if (!(cluster_tolerance > 0 && cluster_tolerance < 0.5)) return fail("the cluster tolerance must be in (0, 0.5)");
+  if (block_rows < 0 || decimate < 0) return fail("block rows and decimation must be >= 0");
+  return true;
+}
+
+double modal_phase_collinearity(const Eigen::VectorXcd& v) {
+  const double sxx = v.real().squaredNorm(), syy = v.imag().squaredNorm(), sxy = v.real().dot(v.imag());
+  const double tr = sxx + syy, det = sxx * syy - sxy * sxy;
+  if (tr <= 0) return 0;
+  const double disc = std::sqrt(std::max(0.0, tr * tr / 4 - det));
+  const double e1 = tr / 2 + disc, e2 = tr / 2 - disc;
+  return std::pow((e1 - e2) / (e1 + e2), 2);
+}
+
+Eigen::VectorXd real_normalize(const Eigen::VectorXcd& v) {
+  // Principal direction of the points (Re v_i, Im v_i): the angle maximizing ||Re(e^{-i theta} v)||.
+  const double sxx = v.real().squaredNorm(), syy = v.imag().squaredNorm(), sxy = v.real().dot(v.imag());
+  const double theta = 0.5 * std::atan2(2 * sxy, sxx - syy);
+  Eigen::VectorXd r = (v * std::exp(std::complex<double>(0, -theta))).real();
+  Eigen::Index i;
+  const double m = r.cwiseAbs().maxCoeff(&i);
+  if (m > 0) r /= (r[i] > 0 ? m : -m);
+  return r;
+}
+
+ModalData IdentificationSummary::modal_data(const std::string& source) const {
+  ModalData d;
+  d.dofs = dofs;
+  d.source = source;
+  const Eigen::Index n = static_cast<Eigen::Index>(modes.size());
+  d.frequencies_hz.resize(n);
+  d.damping_ratios.resize(n);
+  d.mpc.resize(n);
+  d.frequency_std_hz.resize(n);
+  d.damping_std.resize(n);
+  d.shapes.resize(static_cast<Eigen::Index>(dofs.size()), n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const IdentifiedMode& m = modes[static_cast<std::size_t>(k)];
+    d.frequencies_hz[k] = m.frequency_hz;
+    d.damping_ratios[k] = m.damping_ratio;
+    d.mpc[k] = m.mpc;
+    d.frequency_std_hz[k] = m.frequency_std_hz;
+    d.damping_std[k] = m.damping_std;
+    d.shapes.col(k) = m.real_shape;
+  }
+  return d;
+}
+
+IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationOptions& o) {
+  check_band(o);
+  const auto t0 = Clock::now();
+  frf_in.validate("LSCF: " + frf_in.source);
+  // Shapes are residues of the receptance; poles do not depend on the quantity.
+  bool motion = true;
+  for (const Channel& c : frf_in.outputs)
+    motion = motion && (c.quantity == Quantity::kDisplacement || c.quantity == Quantity::kVelocity || c.quantity == Quantity::kAcceleration) &&
+             c.quantity == frf_in.outputs[0].quantity;
+  const FrfData frf = motion ? convert_frf(frf_in, Quantity::kDisplacement) : frf_in;
+  const double lo = std::max(o.band_lo_hz, 0.0), hi = o.band_hi_hz > 0 ? o.band_hi_hz : frf.frequency_hz[frf.frequency_hz.size() - 1];
+  std::vector<Eigen::Index> lines;
+  for (Eigen::Index k = 0; k < frf.frequency_hz.size(); ++k)
+    if (frf.frequency_hz[k] > 0 && frf.frequency_hz[k] >= lo && frf.frequency_hz[k] <= hi) lines.push_back(k);
+  const Eigen::Index nf = static_cast<Eigen::Index>(lines.size());
+  const int ni = frf.num_inputs(), no = frf.num_outputs();
+  const int pmax = o.max_order > 0 ? o.max_order : std::max(10, 60 / ni);
+  const int pmin = o.min_order > 0 ? o.min_order : 2;
+  const int step = o.order_step > 0 ? o.order_step : 1;
+  if (nf < 2 * (pmax + 1)) throw InputError("LSCF: " + std::to_string(nf) + " frequency lines in the band are too few for order " + std::to_string(pmax));
+
+  IdentificationSummary s;
+  s.method = "lscf";
+  for (const Channel& c : frf.outputs) s.dofs.push_back(c.dof);
+  s.min_order = pmin;
+  s.max_order = pmax;
+  s.window_decay_removed = frf.window_decay;
+  Eigen::VectorXd w(nf);
+  Eigen::MatrixXcd H(nf, frf.H.cols());
+  for (Eigen::Index k = 0; k < nf; ++k) {
+    w[k] = 2 * kPi * frf.frequency_hz[lines[k]];
+    H.row(k) = frf.H.row(lines[k]);
+  }
+  s.frequency_hz = frf_in.frequency_hz;
+  s.background = frf_in.H.cwiseAbs().rowwise().sum();
+  s.background_label = "sum of |H|";
+
+  // Basis z^r on the unit circle, dt = 1 / (2 f_top). The normal-equation blocks are Toeplitz in the degree:
+  //   R[r, s] = Re c(s - r),  S_o[r, (s, j)] = -Re h_oj(s - r),  T_o[(r, i), (s, j)] = Re g_oij(s - r),
+  // with c(d) = sum_k z_k^d, h_oj(d) = sum_k H_oj z_k^d, g_oij(d) = sum_k conj(H_oi) H_oj z_k^d, so only their
+  // 2P - 1 diagonals are summed over the frequency lines (O(nf P) per block instead of O(nf P^2)).
+  const double dt = 1.0 / (2 * frf.frequency_hz[lines.back()]);
+  const int P = pmax + 1, D = 2 * P - 1;
+  Eigen::MatrixXcd Z(D, nf);  // Z(d + P - 1, k) = z_k^d
+  for (Eigen::Index k = 0; k < nf; ++k)
+    for (int d = -(P - 1); d <= P - 1; ++d) Z(d + P - 1, k) = std::exp(std::complex<double>(0, w[k] * dt * d));
+  Eigen::MatrixXcd sums(nf, 1 + no * (ni + ni * ni));  // columns: 1, then per output H_oj and conj(H_oi) H_oj
+  sums.col(0).setOnes();
+  for (int oo = 0; oo < no; ++oo) {
+    // Output o's row of H, weighted by 1 / its RMS so every output counts alike.
+    Eigen::MatrixXcd Ho(nf, ni);
+    for (int i = 0; i < ni; ++i) Ho.col(i) = H.col(oo + i * no);
+    const double rms = std::sqrt(Ho.squaredNorm() / static_cast<double>(Ho.size()));
+    if (rms > 0) Ho /= rms;
+    const int base = 1 + oo * (ni + ni * ni);
+    for (int j = 0; j < ni; ++j) sums.col(base + j) = Ho.col(j);
+    for (int i = 0; i < ni; ++i)
+      for (int j = 0; j < ni; ++j) sums.col(base + ni + i * ni + j) = Ho.col(i).conjugate().cwiseProduct(Ho.col(j));
+  }
+  const Eigen::MatrixXd diag = (Z * sums).real();  // D x columns
+  auto at = [&](int col, int d) { return diag(d + P - 1, col); };
+  Eigen::MatrixXd R(P, P);
+  for (int r = 0; r < P; ++r)
+    for (int c = 0; c < P; ++c) R(r, c) = at(0, c - r);
+  std::vector<Eigen::MatrixXd> S(static_cast<std::size_t>(no), Eigen::MatrixXd(P, P * ni)), T(static_cast<std::size_t>(no), Eigen::MatrixXd(P * ni, P * ni));
+  for (int oo = 0; oo < no; ++oo) {
+    const int base = 1 + oo * (ni + ni * ni);
+    for (int r = 0; r < P; ++r)
+      for (int c = 0; c < P; ++c)
+        for (int j = 0; j < ni; ++j) {
+          S[oo](r, c * ni + j) = -at(base + j, c - r);
+          for (int i = 0; i < ni; ++i) T[oo](r * ni + i, c * ni + j) = at(base + ni + i * ni + j, c - r);
+        }
+  }
+  std::vector<std::vector<RawPole>> orders;
+  std::vector<int> order_of;
+  for (int p = pmin; p <= pmax; p += step) {
+    const int q = (p + 1) * ni;
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(q, q);
+    const Eigen::LDLT<Eigen::MatrixXd> Rl(R.topLeftCorner(p + 1, p + 1));
+    for (int oo = 0; oo < no; ++oo) {
+      const Eigen::MatrixXd Sp = S[oo].topLeftCorner(p + 1, q);
+      M += T[oo].topLeftCorner(q, q) - Sp.transpose() * Rl.solve(Sp);
+    }
+    // alpha_p = I: alpha_{0..p-1} = -Maa^-1 Mab.
+    const int a = p * ni;
+    const Eigen::MatrixXd alpha = -M.topLeftCorner(a, a).ldlt().solve(M.topRightCorner(a, ni));
+    // Companion matrix of sum_r alpha_r^T z^r (left eigenvectors of the right fraction: participation).
+    Eigen::MatrixXd C = Eigen::MatrixXd::Zero(a, a);
+    for (int r = 0; r < p; ++r) C.block(0, (p - 1 - r) * ni, ni, ni) = -alpha.block(r * ni, 0, ni, ni).transpose();
+    if (p > 1) C.bottomLeftCorner(a - ni, a - ni).setIdentity();
+    Eigen::EigenSolver<Eigen::MatrixXd> es(C);
+    std::vector<RawPole> poles;
+    if (es.info() == Eigen::Success)
+      for (int k = 0; k < a; ++k) {
+        const std::complex<double> z = es.eigenvalues()[k];
+        if (z.imag() <= 0 || std::abs(z) == 0) continue;
+        RawPole rp;
+        rp.lambda = std::log(z) / dt + frf.window_decay;
+        rp.vec = es.eigenvectors().col(k).tail(ni);
+        poles.push_back(rp);
+      }
+    orders.push_back(std::move(poles));
+    order_of.push_back(p);
+  }
+  const std::vector<std::pair<int, int>> chosen = stabilize_and_select(orders, order_of, lo, hi, o, s);
+  if (!chosen.empty()) {
+    // LSFD at the selected poles of the windowed data (the window's decay put back).
+    std::vector<std::complex<double>> poles;
+    for (const auto& [j, p] : chosen) poles.push_back(orders[j][p].lambda - frf.window_decay);
+    const Eigen::MatrixXcd res = lsfd(w, H, poles);
+    double top = 0;
+    for (std::size_t r = 0; r < s.modes.size(); ++r) {
+      Eigen::MatrixXcd Rr(no, ni);
+      for (int i = 0; i < ni; ++i)
+        for (int oo = 0; oo < no; ++oo) Rr(oo, i) = res(static_cast<Eigen::Index>(r), oo + i * no);
+      Eigen::JacobiSVD<Eigen::MatrixXcd> svd(Rr, Eigen::ComputeThinU);
+      s.modes[r].shape = svd.matrixU().col(0) * svd.singularValues()[0];
+      finish_shape(s.modes[r]);
+      s.modes[r].contribution = Rr.norm() / std::abs(poles[r].real());
+      top = std::max(top, s.modes[r].contribution);
+    }
+    for (IdentifiedMode& m : s.modes) m.contribution = top > 0 ? m.contribution / top : 0;
+  }
+  s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return s;
+}
+
+IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOptions& o) {
+  check_band(o);
+  const auto t0 = Clock::now();
+  rec.validate("SSI: " + rec.source);
+  const std::vector<int> outs = rec.output_channels();
+  const int l = static_cast<int>(outs.size());
+  if (l < 1) throw InputError("SSI: " + rec.source + " has no output channels");
+  const double fs0 = rec.sample_rate_hz;
+  const double hi = o.band_hi_hz > 0 ? o.band_hi_hz : 0.4 * fs0;
+  if (hi > fs0 / 2) throw InputError("SSI: the band's top is above the Nyquist frequency " + std::to_string(fs0 / 2) + " Hz");
+  const int dec = o.decimate > 0 ? o.decimate : std::max(1, static_cast<int>(std::floor(fs0 / (2.5 * hi))));
+  const double fs = fs0 / dec;
+  const double lo = o.band_lo_hz;
+  const int nmax = o.max_order > 0 ? o.max_order : 80;
+  const int nmin = o.min_order > 0 ? o.min_order : 2;
+  const int step = o.order_step > 0 ? o.order_step : 2;
+  const double flow = lo > 0 ? lo : fs / 100;
+  int i = o.block_rows > 0 ? o.block_rows : std::max((nmax + l - 1) / l + 1, static_cast<int>(std::ceil(fs / flow)));
+  i = std::min(i, std::max(2, 1500 / l));
+  if (i * l < nmax) throw InputError("SSI: block rows x outputs (" + std::to_string(i * l) + ") must reach the maximum order " + std::to_string(nmax));
+
+  IdentificationSummary s;
+  s.method = "ssi";
+  for (int c : outs) s.dofs.push_back(rec.channels[c].dof);
+  s.min_order = nmin;
+  s.max_order = nmax;
+
+  // Correlations R_k = E[y_{t+k} y_t^T], k = 0..2i, pooled over records (each demeaned, decimated).
+  std::vector<Eigen::MatrixXd> Rk(static_cast<std::size_t>(2 * i + 1), Eigen::MatrixXd::Zero(l, l));
+  Eigen::VectorXd weight = Eigen::VectorXd::Zero(2 * i + 1);
+  std::vector<Eigen::MatrixXd> decimated;
+  for (const Eigen::MatrixXd& x : rec.records) {
+    Eigen::MatrixXd y(x.rows(), l);
+    for (int c = 0; c < l; ++c) y.col(c) = x.col(outs[c]).array() - x.col(outs[c]).mean();
+    y = decimate(y, dec);
+    if (y.rows() <= 4 * i) throw InputError("SSI: a record of " + rec.source + " has too few samples (" + std::to_string(y.rows()) + " after decimation) for " + std::to_string(i) + " block rows");
+    const std::vector<Eigen::MatrixXd> r = correlations(y, 2 * i);
+    for (int k = 0; k <= 2 * i; ++k) {
+      const double n = static_cast<double>(y.rows() - k);
+      Rk[k] += n * r[k];
+      weight[k] += n;
+    }
+    decimated.push_back(std::move(y));
+  }
+  for (int k = 0; k <= 2 * i; ++k) Rk[k] /= weight[k];
+  // Block Toeplitz T(a, b) = R_{i + a - b}, a, b = 0..i-1.
+  Eigen::MatrixXd Tm(i * l, i * l);
+  for (int a = 0; a < i; ++a)
+    for (int b = 0; b < i; ++b) Tm.block(a * l, b * l, l, l) = Rk[i + a - b];
+  Eigen::BDCSVD<Eigen::MatrixXd> svd(Tm, Eigen::ComputeThinU);
+  const Eigen::VectorXd sv = svd.singularValues();
+  std::vector<std::vector<RawPole>> orders;
+  std::vector<int> order_of;
+  for (int n = nmin; n <= nmax; n += step) {
+    const Eigen::MatrixXd O = svd.matrixU().leftCols(n) * sv.head(n).cwiseSqrt().asDiagonal();
+    const Eigen::MatrixXd A = O.topRows((i - 1) * l).colPivHouseholderQr().solve(O.bottomRows((i - 1) * l));
+    const Eigen::MatrixXd Cm = O.topRows(l);
+    Eigen::EigenSolver<Eigen::MatrixXd> es(A);
+    std::vector<RawPole> poles;
+    if (es.info() == Eigen::Success)
+      for (int k = 0; k < n; ++k) {
+        const std::complex<double> mu = es.eigenvalues()[k];
+        if (mu.imag() <= 0 || std::abs(mu) == 0) continue;
+        RawPole rp;
+        rp.lambda = std::log(mu) * fs;
+        rp.vec = Cm * es.eigenvectors().col(k);
+        poles.push_back(rp);
+      }
+    orders.push_back(std::move(poles));
+    order_of.push_back(n);
+  }
+  const std::vector<std::pair<int, int>> chosen = stabilize_and_select(orders, order_of, lo, hi, o, s);
+  for (std::size_t r = 0; r < chosen.size(); ++r) {
+    s.modes[r].shape = orders[chosen[r].first][chosen[r].second].vec;
+    finish_shape(s.modes[r]);
+  }
+  // Background: first singular value of the output cross-spectral matrix.
+  WelchOptions wo;
+  int seg = 8;
+  const Eigen::Index shortest = std::min_element(decimated.begin(), decimated.end(), [](const auto& a, const auto& b) { return a.rows() < b.rows(); })->rows();
+  while (seg * 2 <= shortest && seg < 8 * fs / flow && seg < (1 << 16)) seg *= 2;
+  wo.segment = seg;
+  const CrossSpectra G = welch(decimated, fs, wo);
+  s.frequency_hz = G.frequency;
+  s.background.resize(G.frequency.size());
+  for (Eigen::Index k = 0; k < G.frequency.size(); ++k)
+    s.background[k] = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXcd>(G.G[k], Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+  s.background_label = "first singular value of the output spectral matrix";
+  s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return s;
+}
+
+}  // namespace dynid
