@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <random>
 
 #include "dynid/engine/frf.hpp"
 #include "dynid/mesh/error.hpp"
@@ -150,6 +151,33 @@ Eigen::MatrixXcd lsfd(const Eigen::VectorXd& w, const Eigen::MatrixXcd& H, const
     for (Eigen::Index c = 0; c < H.cols(); ++c)
       R(r, c) = {scale[2 * r] * x(2 * r, c), scale[2 * r + 1] * x(2 * r + 1, c)};
   return R;
+}
+
+// The k leading left singular vectors and values of a square matrix. Large matrices: randomized range finder
+// with a fixed seed and 4 subspace (power) iterations, then an exact SVD of the small projected matrix; the
+// signal subspace of a correlation Toeplitz matrix is separated by a wide gap, which this resolves to working
+// precision. Small ones: a full SVD.
+void leading_svd(const Eigen::MatrixXd& T, int k, Eigen::MatrixXd* U, Eigen::VectorXd* sv) {
+  const Eigen::Index n = T.rows(), q = std::min<Eigen::Index>(n, k + 30);
+  if (n <= 3 * q) {
+    Eigen::BDCSVD<Eigen::MatrixXd> svd(T, Eigen::ComputeThinU);
+    *U = svd.matrixU();
+    *sv = svd.singularValues();
+    return;
+  }
+  std::mt19937_64 rng(12345);
+  std::normal_distribution<double> g;
+  Eigen::MatrixXd Om(n, q);
+  for (Eigen::Index j = 0; j < q; ++j)
+    for (Eigen::Index i = 0; i < n; ++i) Om(i, j) = g(rng);
+  Eigen::MatrixXd Q = Eigen::HouseholderQR<Eigen::MatrixXd>(T * Om).householderQ() * Eigen::MatrixXd::Identity(n, q);
+  for (int it = 0; it < 4; ++it) {
+    const Eigen::MatrixXd W = Eigen::HouseholderQR<Eigen::MatrixXd>(T.transpose() * Q).householderQ() * Eigen::MatrixXd::Identity(n, q);
+    Q = Eigen::HouseholderQR<Eigen::MatrixXd>(T * W).householderQ() * Eigen::MatrixXd::Identity(n, q);
+  }
+  Eigen::BDCSVD<Eigen::MatrixXd> svd(Q.transpose() * T, Eigen::ComputeThinU);
+  *U = Q * svd.matrixU();
+  *sv = svd.singularValues();
 }
 
 void check_band(const IdentificationOptions& o) {
@@ -363,9 +391,11 @@ IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOpt
   const int nmin = o.min_order > 0 ? o.min_order : 2;
   const int step = o.order_step > 0 ? o.order_step : 2;
   const double flow = lo > 0 ? lo : fs / 100;
-  int i = o.block_rows > 0 ? o.block_rows : std::max((nmax + l - 1) / l + 1, static_cast<int>(std::ceil(fs / flow)));
-  i = std::min(i, std::max(2, 1500 / l));
-  if (i * l < nmax) throw InputError("SSI: block rows x outputs (" + std::to_string(i * l) + ") must reach the maximum order " + std::to_string(nmax));
+  int i = o.block_rows > 0 ? o.block_rows : std::max((nmax + l - 1) / l + 2, static_cast<int>(std::ceil(fs / flow)));
+  i = std::min(i, std::max((nmax + l - 1) / l + 2, 1500 / l));
+  if ((i - 1) * l < nmax)
+    throw InputError("SSI: (block rows - 1) x outputs (" + std::to_string((i - 1) * l) + ") must reach the maximum order " + std::to_string(nmax) +
+                     "; raise the block rows or lower the order");
 
   IdentificationSummary s;
   s.method = "ssi";
@@ -395,14 +425,21 @@ IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOpt
   Eigen::MatrixXd Tm(i * l, i * l);
   for (int a = 0; a < i; ++a)
     for (int b = 0; b < i; ++b) Tm.block(a * l, b * l, l, l) = Rk[i + a - b];
-  Eigen::BDCSVD<Eigen::MatrixXd> svd(Tm, Eigen::ComputeThinU);
-  const Eigen::VectorXd sv = svd.singularValues();
+  Eigen::MatrixXd U;
+  Eigen::VectorXd sv;
+  leading_svd(Tm, nmax, &U, &sv);
+  // A_n = pinv(O_up) O_down with O = U_n S_n^(1/2): from the leading n x n blocks of G = U_up^T U_up and
+  // F = U_up^T U_down (computed once at the largest order), A_n = S^-1/2 G_n^-1 F_n S^1/2.
+  const Eigen::MatrixXd Uq = U.leftCols(nmax);
+  const Eigen::MatrixXd Gm = Uq.topRows((i - 1) * l).transpose() * Uq.topRows((i - 1) * l);
+  const Eigen::MatrixXd Fm = Uq.topRows((i - 1) * l).transpose() * Uq.bottomRows((i - 1) * l);
   std::vector<std::vector<RawPole>> orders;
   std::vector<int> order_of;
   for (int n = nmin; n <= nmax; n += step) {
-    const Eigen::MatrixXd O = svd.matrixU().leftCols(n) * sv.head(n).cwiseSqrt().asDiagonal();
-    const Eigen::MatrixXd A = O.topRows((i - 1) * l).colPivHouseholderQr().solve(O.bottomRows((i - 1) * l));
-    const Eigen::MatrixXd Cm = O.topRows(l);
+    const Eigen::VectorXd sq = sv.head(n).cwiseSqrt();
+    const Eigen::MatrixXd A = sq.cwiseInverse().asDiagonal() * Gm.topLeftCorner(n, n).ldlt().solve(Fm.topLeftCorner(n, n)) * sq.asDiagonal();
+    const Eigen::MatrixXd O = Uq.topRows(l).leftCols(n) * sq.asDiagonal();
+    const Eigen::MatrixXd& Cm = O;
     Eigen::EigenSolver<Eigen::MatrixXd> es(A);
     std::vector<RawPole> poles;
     if (es.info() == Eigen::Success)

@@ -131,25 +131,37 @@ std::vector<Eigen::MatrixXd> correlations(const Eigen::MatrixXd& y, int max_lag)
   if (max_lag < 0 || max_lag >= N) throw InputError("correlations: max_lag must be in [0, samples)");
   int n = 1;
   while (n < N + max_lag + 1) n *= 2;
-  RealFft fft(n);
   const int nf = n / 2 + 1;
   std::vector<Eigen::VectorXcd> Y(static_cast<std::size_t>(l), Eigen::VectorXcd(nf));
-  Eigen::VectorXd buf = Eigen::VectorXd::Zero(n);
-  for (Eigen::Index c = 0; c < l; ++c) {
-    buf.setZero();
-    buf.head(N) = y.col(c);
-    fft.forward(buf.data(), Y[c].data());
-  }
   std::vector<Eigen::MatrixXd> R(static_cast<std::size_t>(max_lag) + 1, Eigen::MatrixXd(l, l));
-  Eigen::VectorXcd prod(nf);
-  Eigen::VectorXd out(n);
+  // Pairs a <= b; the inverse transform of Y_a conj(Y_b) holds sum_t y_a[t + k] y_b[t] at k and
+  // sum_t y_b[t + k] y_a[t] at n - k. Each thread has its own plan and buffers; results do not depend on the
+  // thread count (each entry is computed by one thread the same way).
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> pairs;
   for (Eigen::Index a = 0; a < l; ++a)
-    for (Eigen::Index b = 0; b < l; ++b) {
-      // sum_t y_a[t + k] y_b[t] <-> Y_a conj(Y_b)
-      prod = Y[a].cwiseProduct(Y[b].conjugate());
-      fft.inverse(prod.data(), out.data());
-      for (int k = 0; k <= max_lag; ++k) R[k](a, b) = out[k] / static_cast<double>(N - k);
+    for (Eigen::Index b = a; b < l; ++b) pairs.emplace_back(a, b);
+#pragma omp parallel
+  {
+    RealFft fft(n);
+    Eigen::VectorXd buf = Eigen::VectorXd::Zero(n);
+#pragma omp for schedule(static)
+    for (Eigen::Index c = 0; c < l; ++c) {
+      buf.setZero();
+      buf.head(N) = y.col(c);
+      fft.forward(buf.data(), Y[c].data());
     }
+    Eigen::VectorXcd prod(nf);
+#pragma omp for schedule(dynamic)
+    for (std::size_t p = 0; p < pairs.size(); ++p) {
+      const auto [a, b] = pairs[p];
+      prod = Y[a].cwiseProduct(Y[b].conjugate());
+      fft.inverse(prod.data(), buf.data());
+      for (int k = 0; k <= max_lag; ++k) {
+        R[k](a, b) = buf[k] / static_cast<double>(N - k);
+        R[k](b, a) = buf[k == 0 ? 0 : n - k] / static_cast<double>(N - k);
+      }
+    }
+  }
   return R;
 }
 
