@@ -241,7 +241,7 @@ Case parse_case(const std::string& text, const std::string& name, const std::str
   }
   if (!root || root.IsNull()) throw InputError(name + ": the case file is empty");
   ctx.require_map(root, "case file");
-  ctx.only_keys(root, "the case file", {"name", "description", "model", "analysis", "detect", "update"});
+  ctx.only_keys(root, "the case file", {"name", "description", "model", "analysis", "detect", "update", "test"});
   Case c;
   c.path = name;
   c.dir = dir;
@@ -257,6 +257,7 @@ Case parse_case(const std::string& text, const std::string& name, const std::str
   c.analysis = parse_analysis(root["analysis"], ctx);
   if (root["detect"]) c.detect = parse_detect(root["detect"], ctx, c.model, dir);
   if (root["update"]) c.update = internal::parse_update(root["update"], ctx, c.model, dir);
+  if (root["test"]) c.test = internal::parse_test(root["test"], ctx, c.model, dir);
   return c;
 }
 

@@ -115,6 +115,39 @@ void draw_panel(const Panel& p, double vx0, double vx1, double vy0, double vy1) 
   plmtex("l", 5.4, 0.5, 0.5, p.ylabel.c_str());
   plschr(0, 0.8);
   plmtex("t", 1.0, 0.5, 0.5, p.title.c_str());
+  // Right-axis series (behind), then back to the left axis's window.
+  if (!p.right.empty()) {
+    double r0 = INFINITY, r1 = -INFINITY;
+    for (const Series& s : p.right)
+      for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i)
+        if (std::isfinite(s.y[i]) && (!p.log_right || s.y[i] > 0) && s.x[i] >= x0 && s.x[i] <= x1) {
+          r0 = std::min(r0, tr(s.y[i], p.log_right));
+          r1 = std::max(r1, tr(s.y[i], p.log_right));
+        }
+    if (!std::isfinite(r0)) r0 = 0, r1 = 1;
+    if (r1 == r0) r0 -= 0.5, r1 += 0.5;
+    if (p.log_right) r0 = std::floor(r0), r1 = std::ceil(r1);
+    plwind(x0, x1, r0, r1);
+    int rc = kFirst + 7;  // grey
+    for (const Series& s : p.right) {
+      plcol0(s.color >= 0 ? kFirst + (s.color % 10) : rc);
+      plwidth(s.width);
+      std::vector<PLFLT> xs, ys;
+      for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i)
+        if (std::isfinite(s.y[i]) && s.x[i] >= x0 && s.x[i] <= x1) {
+          xs.push_back(s.x[i]);
+          ys.push_back(p.log_right && s.y[i] <= 0 ? r0 : tr(s.y[i], p.log_right));
+        }
+      plline(static_cast<PLINT>(xs.size()), xs.data(), ys.data());
+    }
+    plcol0(kAxis);
+    plwidth(1.0);
+    plschr(0, 0.62);
+    plbox("", 0, 0, p.log_right ? "cmstlv" : "cmstv", 0, 0);
+    plschr(0, 0.7);
+    plmtex("r", 4.5, 0.5, 0.5, p.ylabel_right.c_str());
+    plwind(x0, x1, y0, y1);
+  }
   // Reference lines.
   for (const auto& h : p.hlines) {
     if (p.log_y && h.first <= 0) continue;
@@ -150,7 +183,11 @@ void draw_panel(const Panel& p, double vx0, double vx1, double vy0, double vy1) 
     const double base = p.log_y ? y0 : std::max(y0, std::min(0.0, y1));
     switch (s.kind) {
       case Kind::kLine: plline(n, xs.data(), ys.data()); break;
-      case Kind::kMarkers: plpoin(n, xs.data(), ys.data(), 17); break;
+      case Kind::kMarkers:
+        plssym(0, s.symbol_scale);
+        plpoin(n, xs.data(), ys.data(), s.symbol);
+        plssym(0, 1.0);
+        break;
       case Kind::kLineMarkers:
         plline(n, xs.data(), ys.data());
         plpoin(n, xs.data(), ys.data(), 17);

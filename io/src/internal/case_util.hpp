@@ -23,5 +23,7 @@ namespace dynid::internal {
 
 /// The `update:` section (io/src/case_update.cpp).
 UpdateSpec parse_update(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir);
+/// The `test:` section (io/src/case_test.cpp).
+TestSpec parse_test(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir);
 
 }  // namespace dynid::internal

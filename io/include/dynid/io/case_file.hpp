@@ -8,6 +8,8 @@
 #include <optional>
 
 #include "dynid/engine/detect.hpp"
+#include "dynid/engine/identify.hpp"
+#include "dynid/engine/virtual_test.hpp"
 #include "dynid/engine/model_fit.hpp"
 #include "dynid/engine/parametric.hpp"
 #include "dynid/mesh/model.hpp"
@@ -52,6 +54,17 @@ struct UpdateSpec {
   FitOptions options;
 };
 
+/// What `test:` asks for (docs/case-file.md): a virtual test of the case's model (`dynid simulate-test`), the
+/// file it writes, and how to identify its recordings (`dynid identify`, `dynid run`).
+struct TestSpec {
+  VirtualTestOptions options;
+  std::string output;              ///< UFF 58 file (resolved against the case folder); "" = <case>-test.uff
+  bool binary = true;              ///< 58b (binary) or ASCII 58
+  double max_frequency_hz = 0;     ///< modes computed up to here (0 = 1.2 x Nyquist)
+  std::string method;              ///< identification: "lscf" or "ssi" ("" = lscf for impact/random, ssi for ambient)
+  IdentificationOptions identify;
+};
+
 struct Case {
   std::string path;         ///< the case file
   std::string dir;          ///< its folder (relative paths in the case resolve against it)
@@ -60,6 +73,7 @@ struct Case {
   AnalysisSpec analysis;
   std::optional<DetectSpec> detect;
   std::optional<UpdateSpec> update;
+  std::optional<TestSpec> test;
 };
 
 /// Loads a case from a case file, or from a folder holding case.yaml / case.yml / case.json.

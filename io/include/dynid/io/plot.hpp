@@ -19,6 +19,8 @@ struct Series {
   double bar_width = 0.8;
   std::vector<double> yerr;  ///< optional symmetric error bars (one per point; NaN = none)
   double dx = 0;             ///< horizontal offset (to place grouped markers side by side)
+  int symbol = 17;           ///< PLplot marker code for markers (17 filled dot, 4 circle, 2 plus, 5 cross, 7 triangle)
+  double symbol_scale = 1.0;
 };
 
 struct Panel {
@@ -29,6 +31,11 @@ struct Panel {
   double xmin = std::numeric_limits<double>::quiet_NaN(), xmax = xmin, ymin = xmin, ymax = xmin;
   std::vector<std::pair<double, std::string>> hlines;  ///< horizontal reference lines (value, label)
   bool legend = true;
+  /// Series on a second y axis at the right (drawn first, behind the others), e.g. an FRF behind a
+  /// stabilization diagram.
+  std::vector<Series> right;
+  std::string ylabel_right;
+  bool log_right = true;
 };
 
 struct Figure {

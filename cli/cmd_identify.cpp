@@ -1,0 +1,259 @@
+// dynid identify RECORDINGS... : modal identification (LSCF on FRFs or input/output recordings, SSI-cov on
+// output-only recordings). dynid simulate-test CASE : a virtual test of a case's model, written as UFF 58.
+#include <fmt/core.h>
+
+#include <filesystem>
+
+#include "commands.hpp"
+#include "dynid/engine/frf.hpp"
+#include "dynid/engine/identify.hpp"
+#include "dynid/engine/virtual_test.hpp"
+#include "dynid/io/case_file.hpp"
+#include "dynid/io/identify_io.hpp"
+#include "dynid/io/modal_data_io.hpp"
+#include "dynid/io/output.hpp"
+#include "dynid/io/test_data.hpp"
+#include "dynid/io/uff.hpp"
+#include "dynid/mesh/error.hpp"
+#include "progress.hpp"
+
+namespace dynid::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct IdentifyArgs {
+  std::vector<std::string> files;
+  std::string method, json, uff, plot, out_stem;
+  std::vector<double> band, orders;
+  std::vector<std::string> outputs, inputs;  // DOF labels for FRF text files
+  bool frf_text = false, force = false;
+  double fs = 0, exponential = 0;
+  int segment = -1;
+  std::string estimator = "h1";
+};
+
+std::vector<MeasuredDof> labels(const std::vector<std::string>& l, const char* what) {
+  std::vector<MeasuredDof> out;
+  for (const std::string& s : l) {
+    MeasuredDof d;
+    if (!parse_dof_label(s, &d)) throw InputError(std::string(what) + ": '" + s + "' is not a DOF label (e.g. 13ux, 13+Y)");
+    out.push_back(d);
+  }
+  return out;
+}
+
+// Merges FRF sets with the same outputs and frequency grid: their inputs side by side.
+FrfData merge_frfs(std::vector<FrfData> sets) {
+  FrfData out = std::move(sets[0]);
+  for (std::size_t k = 1; k < sets.size(); ++k) {
+    const FrfData& s = sets[k];
+    if (s.frequency_hz.size() != out.frequency_hz.size() || !s.frequency_hz.isApprox(out.frequency_hz))
+      throw InputError(s.source + ": its frequency lines differ from " + out.source + "'s; FRFs identified together must share them");
+    if (s.outputs.size() != out.outputs.size()) throw InputError(s.source + ": its outputs differ from " + out.source + "'s");
+    for (std::size_t o = 0; o < s.outputs.size(); ++o)
+      if (!(s.outputs[o].dof == out.outputs[o].dof)) throw InputError(s.source + ": its outputs differ from " + out.source + "'s");
+    Eigen::MatrixXcd H(out.H.rows(), out.H.cols() + s.H.cols());
+    H << out.H, s.H;
+    out.H = H;
+    out.inputs.insert(out.inputs.end(), s.inputs.begin(), s.inputs.end());
+    if (out.coherence.size() && s.coherence.size()) {
+      Eigen::MatrixXd C(out.coherence.rows(), out.coherence.cols() + s.coherence.cols());
+      C << out.coherence, s.coherence;
+      out.coherence = C;
+    } else {
+      out.coherence.resize(0, 0);
+    }
+  }
+  out.validate("identify");
+  return out;
+}
+
+std::string describe_mode(const IdentifiedMode& m, bool lscf) {
+  if (!lscf) return m.mpc >= 0.9 ? "" : "complex (MPC < 0.9): check closely spaced modes or noise";
+  if (m.contribution >= 0.1) return "dominant";
+  if (m.contribution >= 0.01) return "minor mode";
+  return "weak (< 1 % of the strongest peak): a local or noise mode";
+}
+
+int run_identify(const IdentifyArgs& a, const GlobalOptions& g) {
+  set_threads(g.threads);
+  Progress progress(!g.quiet);
+  progress.update("reading", -1);
+  IdentificationOptions io;
+  if (!a.band.empty()) io.band_lo_hz = a.band[0], io.band_hi_hz = a.band[1];
+  if (!a.orders.empty()) io.min_order = static_cast<int>(a.orders[0]), io.max_order = static_cast<int>(a.orders[1]);
+  std::string why;
+  if (!io.IsValid(&why)) throw InputError("identify: " + why);
+
+  std::vector<FrfData> frfs;
+  std::vector<Recording> recs;
+  if (a.frf_text) {
+    const std::vector<MeasuredDof> outs = labels(a.outputs, "--outputs"), ins = labels(a.inputs, "--inputs");
+    if (outs.size() != a.files.size() && outs.size() != 1)
+      throw InputError("identify: --frf needs one --outputs DOF per file (or one for all); got " + std::to_string(outs.size()) + " for " +
+                       std::to_string(a.files.size()) + " files");
+    if (ins.size() != a.files.size() && ins.size() != 1)
+      throw InputError("identify: --frf needs one --inputs DOF per file (or one for all)");
+    std::vector<MeasuredDof> o(a.files.size()), i(a.files.size());
+    for (std::size_t k = 0; k < a.files.size(); ++k) {
+      o[k] = outs[outs.size() == 1 ? 0 : k];
+      i[k] = ins[ins.size() == 1 ? 0 : k];
+    }
+    frfs.push_back(read_frf_text_set(a.files, o, i));
+  } else {
+    for (const std::string& f : a.files) {
+      TestData d = read_test_data(f, a.fs);
+      if (d.kind == TestData::Kind::kUff) {
+        bool has_frf = false, has_time = false;
+        for (const UffDataset& ds : d.uff.datasets)
+          if (const Uff58* u = std::get_if<Uff58>(&ds)) {
+            has_frf = has_frf || u->function_type == 4;
+            has_time = has_time || u->function_type == 1;
+          }
+        if (has_frf) frfs.push_back(uff_frf(d.uff));
+        else if (has_time) recs.push_back(uff_recording(d.uff));
+        else throw InputError(f + ": holds no time responses (58, function type 1) and no FRFs (58, type 4)");
+      } else if (d.kind == TestData::Kind::kTimeHistory) {
+        recs.push_back(std::move(d.recording));
+      } else {
+        throw InputError(f + ": a spectrum cannot be identified from; give time histories, FRFs (--frf for text files) or UFF 58");
+      }
+    }
+  }
+  if (!frfs.empty() && !recs.empty()) throw InputError("identify: give either FRFs or time recordings, not both");
+
+  std::string method = a.method;
+  bool has_inputs = false;
+  for (const Recording& r : recs) has_inputs = has_inputs || !r.input_channels().empty();
+  if (method.empty()) method = !frfs.empty() || has_inputs ? "lscf" : "ssi";
+  IdentificationSummary s;
+  progress.update("identifying (" + method + ")", -1);
+  if (method == "lscf") {
+    if (frfs.empty()) {
+      if (!has_inputs) throw InputError("identify: LSCF needs FRFs or recordings with a force channel; these are output-only: use --method ssi");
+      FrfOptions fo;
+      fo.estimator = a.estimator == "h2" ? FrfOptions::Estimator::kH2 : FrfOptions::Estimator::kH1;
+      fo.segment = a.segment >= 0 ? a.segment : 0;
+      fo.exponential_end = a.exponential;
+      if (io.band_hi_hz > 0) fo.max_frequency_hz = std::min(1.25 * io.band_hi_hz, recs[0].sample_rate_hz / 2);
+      frfs.push_back(estimate_frf(recs, fo));
+    }
+    s = identify_lscf(merge_frfs(std::move(frfs)), io);
+  } else {
+    if (recs.empty()) throw InputError("identify: SSI works on time recordings (output-only); FRFs go to --method lscf");
+    if (recs.size() > 1) {
+      for (std::size_t k = 1; k < recs.size(); ++k) {
+        if (recs[k].sample_rate_hz != recs[0].sample_rate_hz || recs[k].num_channels() != recs[0].num_channels())
+          throw InputError("identify: recordings identified together need the same channels and sampling rate (" + recs[k].source + ")");
+        recs[0].records.insert(recs[0].records.end(), recs[k].records.begin(), recs[k].records.end());
+      }
+    }
+    s = identify_ssi(recs[0], io);
+  }
+  progress.done();
+
+  const std::string stem = a.out_stem.empty() ? fs::path(a.files[0]).stem().string() + "-" + method : a.out_stem;
+  const std::string json = a.json.empty() ? stem + "-modes.json" : a.json;
+  const std::string uff = a.uff.empty() ? stem + "-modes.uff" : a.uff;
+  const std::string png = a.plot.empty() ? stem + "-stabilization.png" : a.plot;
+  const ModalData md = s.modal_data("dynid identify " + method);
+  // Refuse before writing anything if an output exists (no partial results).
+  for (const std::string& p : {json, uff, png})
+    if (!a.force && fs::exists(p)) throw InputError(p + ": file exists; pass --force to overwrite it");
+  if (!md.frequencies_hz.size() == 0) write_uff55(uff, md, a.force);
+  write_file_atomic(json, identification_json(s).dump(1) + "\n", a.force);
+  plot::save(stabilization_figure(s, "dynid identify: " + fs::path(a.files[0]).filename().string() + (a.files.size() > 1 ? " ..." : "")), png, a.force);
+
+  if (!g.quiet) {
+    fmt::print("dynid identify: {} on {} output DOFs, orders {}-{}, {:.2f} s\n", method, s.dofs.size(), s.min_order, s.max_order, s.seconds);
+    if (s.window_decay_removed > 0) fmt::print("  exponential window: {:.4g} 1/s of decay taken off every pole\n", s.window_decay_removed);
+    fmt::print("  mode  frequency [Hz]  (std)     damping [%]  (std)    MPC     poles  {}  assessment\n", method == "lscf" ? "contribution" : "");
+    for (std::size_t k = 0; k < s.modes.size(); ++k) {
+      const IdentifiedMode& m = s.modes[k];
+      fmt::print("  {:4d}  {:<14.6g}  ({:<7.2g})  {:<11.4g}  ({:<6.2g})  {:.4f}  {:5d}  {}  {}\n", k + 1, m.frequency_hz, m.frequency_std_hz,
+                 100 * m.damping_ratio, 100 * m.damping_std, m.mpc, m.poles, method == "lscf" ? fmt::format("{:12.3f}", m.contribution) : "",
+                 describe_mode(m, method == "lscf"));
+    }
+    if (s.modes.empty()) fmt::print("  no stable physical poles in the band: widen the band or raise the maximum order\n");
+    fmt::print("  wrote {}, {}{}\n", json, md.frequencies_hz.size() ? uff + ", " : "", png);
+  }
+  return 0;
+}
+
+struct SimulateArgs {
+  std::string case_path, output;
+  bool force = false;
+};
+
+int run_simulate(const SimulateArgs& a, const GlobalOptions& g) {
+  set_threads(g.threads);
+  const Case c = load_case(a.case_path);
+  if (!c.test) throw InputError(c.path + ": the case has no test: section (see docs/case-file.md)");
+  const TestSpec& t = *c.test;
+  Progress progress(!g.quiet);
+  progress.update("modes", -1);
+  const double nyquist = t.options.sample_rate_hz / 2;
+  EigenOptions eo = c.analysis.eigen_options();
+  eo.band_lo = 0;
+  eo.band_hi = hz_to_eigenvalue(t.max_frequency_hz > 0 ? t.max_frequency_hz : 1.2 * nyquist);
+  const ModalResult modes = modal_analysis(c.model, eo);
+  if (!modes.ok()) throw NumericalError("modal analysis failed: " + modes.summary.message);
+  progress.update("simulating", -1);
+  const VirtualTest vt = simulate_test(c.model, modes, t.options);
+  progress.done();
+  std::string out = !a.output.empty() ? a.output : !t.output.empty() ? t.output : (fs::path(c.dir) / (c.name + "-test.uff")).string();
+  std::vector<UffDataset> ds;
+  for (const Recording& r : vt.recordings) {
+    std::vector<UffDataset> d = uff_datasets(r, t.binary);
+    ds.insert(ds.end(), d.begin(), d.end());
+  }
+  write_uff(out, ds, a.force);
+  const std::string truth = fs::path(out).replace_extension(".truth.json").string();
+  write_modal_data(truth, vt.modes, a.force);
+  if (!g.quiet) {
+    std::size_t records = 0;
+    for (const Recording& r : vt.recordings) records += r.records.size();
+    fmt::print("dynid simulate-test: {} — {} sensors, {} records of {} samples at {} Hz, {} modes below Nyquist\n", c.name,
+               t.options.sensors.size(), records, vt.recordings[0].records[0].rows(), t.options.sample_rate_hz, vt.modes.num_modes());
+    fmt::print("  wrote {} ({} datasets, UFF 58{}) and the simulated modes to {}\n", out, ds.size(), t.binary ? "b" : "", truth);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void register_identify(CLI::App& app, GlobalOptions& g) {
+  auto a = std::make_shared<IdentifyArgs>();
+  CLI::App* cmd = app.add_subcommand("identify", "Modal identification from recordings: LSCF + LSFD (FRFs, or force and responses) or SSI-cov (output-only)");
+  cmd->add_option("RECORDINGS", a->files, "UFF 58 files (time or FRF), text/CSV time histories, LabVIEW .lvm, or FRF text files with --frf")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--method", a->method, "lscf or ssi (default: lscf when there are FRFs or a force channel, else ssi)")
+      ->check(CLI::IsMember({"lscf", "ssi"}));
+  cmd->add_option("--band", a->band, "Analysis band LO HI in Hz")->expected(2);
+  cmd->add_option("--orders", a->orders, "Model orders MIN MAX")->expected(2);
+  cmd->add_option("--json", a->json, "Modal data JSON (default: <first file>-<method>-modes.json)");
+  cmd->add_option("--uff", a->uff, "Modal data UFF 55 (default: <first file>-<method>-modes.uff)");
+  cmd->add_option("--plot", a->plot, "Stabilization diagram .png/.svg (default: <first file>-<method>-stabilization.png)");
+  cmd->add_option("--out", a->out_stem, "Stem for the default output names");
+  cmd->add_flag("--frf", a->frf_text, "The files are FRF text files (frequency, real, imaginary)");
+  cmd->add_option("--outputs", a->outputs, "With --frf: output DOF of each file (or one for all), e.g. 1ux,2ux")->delimiter(',');
+  cmd->add_option("--inputs", a->inputs, "With --frf: input DOF of each file (or one for all)")->delimiter(',');
+  cmd->add_option("--fs", a->fs, "Sampling rate for text files without a time column (Hz)");
+  cmd->add_option("--estimator", a->estimator, "FRF estimator for force + response recordings: h1 or h2")->check(CLI::IsMember({"h1", "h2"}));
+  cmd->add_option("--segment", a->segment, "Welch segment length in samples (default: whole records, for impacts)");
+  cmd->add_option("--exponential", a->exponential, "Exponential window on impact records: its end value, e.g. 0.05 (its damping is removed)");
+  cmd->add_flag("--force", a->force, "Overwrite existing output files");
+  cmd->callback([a, &g]() { g.exit_code = run_guarded("identify", [&] { return run_identify(*a, g); }); });
+
+  auto s = std::make_shared<SimulateArgs>();
+  CLI::App* sim = app.add_subcommand("simulate-test", "Simulate the vibration test in a case's test: section and write the recordings (UFF 58)");
+  sim->add_option("CASE", s->case_path, "Case file or folder with a test: section")->required();
+  sim->add_option("-o,--output", s->output, "UFF file to write (default: the case's test output, or <case>-test.uff beside it)");
+  sim->add_flag("--force", s->force, "Overwrite existing output files");
+  sim->callback([s, &g]() { g.exit_code = run_guarded("simulate-test", [&] { return run_simulate(*s, g); }); });
+}
+
+}  // namespace dynid::cli

@@ -1,0 +1,84 @@
+#include "dynid/io/identify_io.hpp"
+
+#include <fmt/core.h>
+
+#include "dynid/io/modal_data_io.hpp"
+
+namespace dynid {
+
+nlohmann::ordered_json identification_json(const IdentificationSummary& s) {
+  nlohmann::ordered_json j;
+  j["method"] = s.method;
+  nlohmann::ordered_json dofs = nlohmann::ordered_json::array();
+  for (const MeasuredDof& d : s.dofs) dofs.push_back(to_string(d));
+  j["dofs"] = dofs;
+  j["orders"] = {s.min_order, s.max_order};
+  j["seconds"] = s.seconds;
+  j["window_decay_removed"] = s.window_decay_removed;
+  nlohmann::ordered_json modes = modal_data_json(s.modal_data(s.method))["modes"];
+  for (std::size_t k = 0; k < s.modes.size(); ++k) {
+    modes[k]["contribution"] = s.modes[k].contribution;
+    modes[k]["poles"] = s.modes[k].poles;
+  }
+  j["modes"] = modes;
+  return j;
+}
+
+plot::Figure stabilization_figure(const IdentificationSummary& s, const std::string& title) {
+  plot::Figure f;
+  f.title = title;
+  f.width = 1400;
+  f.height = 850;
+  plot::Panel p;
+  p.title = "Stabilization diagram (" + s.method + ", orders " + std::to_string(s.min_order) + "-" + std::to_string(s.max_order) + ")";
+  p.xlabel = "frequency [Hz]";
+  p.ylabel = "model order";
+  p.ylabel_right = s.background_label;
+  plot::Series bg;
+  bg.label = "";
+  for (Eigen::Index k = 0; k < s.frequency_hz.size(); ++k) {
+    bg.x.push_back(s.frequency_hz[k]);
+    bg.y.push_back(s.background[k]);
+  }
+  bg.width = 1.2;
+  p.right.push_back(bg);
+  // Pole classes, drawn from the least to the most stable.
+  plot::Series fresh{".  new or unstable pole", {}, {}, plot::Kind::kMarkers, 7}, f_only{"x  stable in frequency", {}, {}, plot::Kind::kMarkers, 1},
+      fd{"+  stable in frequency, damping", {}, {}, plot::Kind::kMarkers, 2},
+      all{"o  stable in frequency, damping, vector", {}, {}, plot::Kind::kMarkers, 0};
+  fresh.symbol = 1, fresh.symbol_scale = 1.6;
+  f_only.symbol = 5, f_only.symbol_scale = 0.7;
+  fd.symbol = 2, fd.symbol_scale = 0.8;
+  all.symbol = 4, all.symbol_scale = 0.75;
+  double lo = 1e300, hi = 0;
+  for (const StabilizationPole& q : s.poles) {
+    if (!q.physical) continue;
+    lo = std::min(lo, q.frequency_hz);
+    hi = std::max(hi, q.frequency_hz);
+    plot::Series& t = q.stable() ? all : (q.stable_frequency && q.stable_damping) ? fd : q.stable_frequency ? f_only : fresh;
+    t.x.push_back(q.frequency_hz);
+    t.y.push_back(q.order);
+  }
+  for (plot::Series* t : {&fresh, &f_only, &fd, &all})
+    if (!t->x.empty()) p.series.push_back(*t);
+  for (std::size_t k = 0; k < s.modes.size(); ++k) {
+    plot::Series v;
+    v.label = k == 0 ? "selected modes" : "";
+    v.x = {s.modes[k].frequency_hz, s.modes[k].frequency_hz};
+    v.y = {static_cast<double>(s.min_order), static_cast<double>(s.max_order)};
+    v.color = 3;
+    v.width = 1.4;
+    p.series.push_back(v);
+  }
+  if (hi > lo) {
+    const double pad = 0.02 * (hi - lo);
+    p.xmin = std::max(0.0, lo - pad);
+    p.xmax = hi + pad;
+  }
+  p.ymin = 0;
+  p.ymax = s.max_order + 2;
+  f.panels.push_back(p);
+  return f;
+}
+
+}  // namespace dynid
