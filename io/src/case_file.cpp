@@ -252,7 +252,7 @@ Case parse_case(const std::string& text, const std::string& name, const std::str
     YamlCtx mctx = ctx;
     std::string mdir = dir;
     const YAML::Node m = model_node(root, &mctx, &mdir, 0);
-    c.model = internal::parse_model(m, mctx);
+    c.model = internal::parse_model(m, mctx, mdir, &c.notes);
   }
   c.analysis = parse_analysis(root["analysis"], ctx);
   if (root["detect"]) c.detect = parse_detect(root["detect"], ctx, c.model, dir);
