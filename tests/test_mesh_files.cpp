@@ -4,6 +4,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <unistd.h>
+
 #include "dynid/engine/modal.hpp"
 #include "dynid/io/case_file.hpp"
 #include "dynid/io/mesh_files.hpp"
@@ -27,7 +29,7 @@ std::string Slurp(const std::string& path) {
 
 /// Writes `text` to a file in a scratch folder and returns its path.
 std::string Write(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::path(::testing::TempDir()) / "dynid_mesh_files";
+  static const fs::path dir = fs::path(::testing::TempDir()) / ("dynid_mesh_files_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const std::string p = (dir / name).string();
   std::ofstream(p, std::ios::binary) << text;

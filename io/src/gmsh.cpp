@@ -106,7 +106,7 @@ class Cursor {
   /// trusted before the file can hold it (each entry needs `numbers` text numbers or `bytes` binary bytes).
   long long count(const std::string& what, int binary_bytes_of_count, int numbers, std::size_t bytes) {
     const long long n = integer(what, binary_bytes_of_count);
-    const std::size_t per = binary_ ? bytes : 2 * static_cast<std::size_t>(numbers);
+    const std::size_t per = std::max<std::size_t>(binary_ ? bytes : 2 * static_cast<std::size_t>(numbers), 1);
     if (n < 0 || static_cast<unsigned long long>(n) > remaining() / per)
       fail(what + " is " + std::to_string(n) + ", but only " + std::to_string(remaining()) +
            " bytes follow (a corrupt or truncated file?)");
