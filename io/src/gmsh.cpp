@@ -53,16 +53,16 @@ class Cursor {
 
   /// "file:line" of the last token (ASCII) or "file: byte N" (binary data).
   std::string here() const {
-    if (binary_) return file_ + ": byte " + std::to_string(start_);
-    const auto line = std::count(data_.begin(), data_.begin() + static_cast<std::ptrdiff_t>(start_), '\n') + 1;
-    return file_ + ":" + std::to_string(line);
+    return binary_ ? file_ + ": byte " + std::to_string(start_) : file_ + ":" + std::to_string(token_line_);
   }
   [[noreturn]] void fail(const std::string& msg) const { throw InputError(here() + ": " + msg); }
 
   /// The next whitespace-separated token ("" at the end of the file).
   std::string token() {
-    while (pos_ < data_.size() && std::isspace(static_cast<unsigned char>(data_[pos_]))) ++pos_;
+    for (; pos_ < data_.size() && std::isspace(static_cast<unsigned char>(data_[pos_])); ++pos_)
+      if (data_[pos_] == '\n') ++line_;
     start_ = pos_;
+    token_line_ = line_;
     while (pos_ < data_.size() && !std::isspace(static_cast<unsigned char>(data_[pos_]))) ++pos_;
     return data_.substr(start_, pos_ - start_);
   }
@@ -123,6 +123,7 @@ class Cursor {
 
   /// Expects `$End<name>`.
   void expect_end(const std::string& name) {
+    if (binary_) line_ = static_cast<int>(std::count(data_.begin(), data_.begin() + static_cast<std::ptrdiff_t>(pos_), '\n')) + 1;
     binary_ = false;
     const std::string t = token();
     if (t != "$End" + name)
@@ -133,6 +134,7 @@ class Cursor {
   void skip_section(const std::string& name) {
     const std::size_t e = data_.find("$End" + name, pos_);
     if (e == std::string::npos) fail("$" + name + " has no $End" + name);
+    line_ += static_cast<int>(std::count(data_.begin() + static_cast<std::ptrdiff_t>(pos_), data_.begin() + static_cast<std::ptrdiff_t>(e), '\n'));
     pos_ = e + 4 + name.size();
   }
 
@@ -154,7 +156,8 @@ class Cursor {
   }
 
   std::string file_, data_;
-  std::size_t pos_ = 0, start_ = 0;
+  std::size_t pos_ = 0, start_ = 0;  // read position; start of the last token or binary value
+  int line_ = 1, token_line_ = 1;    // line at pos_ and of the last token (text only)
   bool binary_ = false;
 };
 
