@@ -5,30 +5,18 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <sstream>
 #include <unordered_map>
 
 #include "dynid/io/mesh_files.hpp"
 #include "dynid/mesh/error.hpp"
+#include "internal/file_util.hpp"
 #include "internal/sections.hpp"
 
 namespace dynid {
 
 namespace fs = std::filesystem;
-
-namespace internal {
-
-std::string read_file_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open the file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-}  // namespace internal
 
 const MeshGroup* MeshData::find_group(const std::string& name) const {
   std::string key = name;

@@ -9,6 +9,7 @@
 
 #include "dynid/io/mesh_files.hpp"
 #include "dynid/mesh/error.hpp"
+#include "internal/file_util.hpp"
 
 namespace dynid {
 
@@ -260,6 +261,18 @@ class GmshReader {
     return x;
   }
 
+  /// The header of a 4.1 $Nodes or $Elements section: the number of entity blocks (returned), the number of
+  /// entries (*total; each at least `numbers` text numbers or `bytes` binary bytes), the minimum and maximum tag.
+  long long block_header(const std::string& section, const std::string& entries, int numbers, std::size_t bytes,
+                         long long* total) {
+    if (binary_) c_.begin_binary();
+    const long long blocks = c_.count(section + ": number of entity blocks", 8, 4, 20);
+    *total = c_.count(section + ": number of " + entries, 8, numbers, bytes);
+    c_.integer(section + ": minimum tag", 8);
+    c_.integer(section + ": maximum tag", 8);
+    return blocks;
+  }
+
   void nodes() {
     if (have_nodes_) c_.fail("a second $Nodes section (only one is supported)");
     have_nodes_ = true;
@@ -273,11 +286,8 @@ class GmshReader {
       c_.expect_end("Nodes");
       return;
     }
-    if (binary_) c_.begin_binary();
-    const long long blocks = c_.count("$Nodes: number of entity blocks", 8, 4, 20);
-    const long long total = c_.count("$Nodes: number of nodes", 8, 4, 32);
-    c_.integer("$Nodes: minimum node tag", 8);
-    c_.integer("$Nodes: maximum node tag", 8);
+    long long total = 0;
+    const long long blocks = block_header("$Nodes", "nodes", 4, 32, &total);
     for (long long b = 0; b < blocks; ++b) {
       const int dim = static_cast<int>(c_.integer("$Nodes: entity dimension", 4));
       c_.integer("$Nodes: entity tag", 4);
@@ -355,11 +365,8 @@ class GmshReader {
     if (have_elements_) c_.fail("a second $Elements section (only one is supported)");
     have_elements_ = true;
     if (version_ < 4) return elements22();
-    if (binary_) c_.begin_binary();
-    const long long blocks = c_.count("$Elements: number of entity blocks", 8, 4, 20);
-    const long long total = c_.count("$Elements: number of elements", 8, 2, 16);
-    c_.integer("$Elements: minimum element tag", 8);
-    c_.integer("$Elements: maximum element tag", 8);
+    long long total = 0;
+    const long long blocks = block_header("$Elements", "elements", 2, 16, &total);
     long long read = 0;
     for (long long b = 0; b < blocks; ++b) {
       const int dim = static_cast<int>(c_.integer("$Elements: entity dimension", 4));

@@ -91,6 +91,21 @@ struct Parser {
     }
   }
 
+  /// A beam or frame element type: beam2d | frame2d | frame3d.
+  ElementType member_type(const YAML::Node& n, const std::string& w, const std::string& hint = "") const {
+    const std::string t = ctx.string(n, w + " type");
+    ElementType type;
+    if (!parse_element_type(t, &type) || type == ElementType::PointMass || type == ElementType::Spring)
+      fail(n, w + ": unknown element type '" + t + "' (known: beam2d, frame2d, frame3d" + hint + ")");
+    return type;
+  }
+  /// orientation: [x, y, z] (frame3d: a vector in the local x-z plane).
+  Eigen::Vector3d orientation_of(const YAML::Node& n, const std::string& w) const {
+    const auto v = ctx.numbers(n, w + " orientation");
+    if (v.size() != 3) fail(n, w + ": orientation must be [x, y, z]");
+    return Eigen::Vector3d(v[0], v[1], v[2]);
+  }
+
   int material_of(const YAML::Node& n, const std::string& w) {
     const std::string name = n ? ctx.string(n, w + " material") : default_material;
     if (name.empty()) fail(n, w + ": no material (give material: or model.defaults.material)");
@@ -166,9 +181,7 @@ struct Parser {
         el.id = ctx.integer(e["id"], "element id");
         w = "element " + std::to_string(el.id);
         if (e["type"]) {
-          const std::string t = ctx.string(e["type"], w + " type");
-          if (!parse_element_type(t, &el.type) || el.type == ElementType::PointMass || el.type == ElementType::Spring)
-            fail(e["type"], w + ": unknown element type '" + t + "' (known: beam2d, frame2d, frame3d; point masses and springs have their own lists)");
+          el.type = member_type(e["type"], w, "; point masses and springs have their own lists");
         } else if (!have_default_type) {
           fail(e, w + ": no element type (give type: or model.element)");
         }
@@ -177,11 +190,7 @@ struct Parser {
         el.node_ids = {{node_ref(nd[0], w), node_ref(nd[1], w)}};
         el.material = material_of(e["material"], w);
         el.section = section_of(e["section"], w);
-        if (e["orientation"]) {
-          const auto v = ctx.numbers(e["orientation"], w + " orientation");
-          if (v.size() != 3) fail(e["orientation"], w + ": orientation must be [x, y, z]");
-          el.orientation = Eigen::Vector3d(v[0], v[1], v[2]);
-        }
+        if (e["orientation"]) el.orientation = orientation_of(e["orientation"], w);
         if (e["group"]) el.group = ctx.string(e["group"], w + " group");
       } else {
         fail(e, "element: expected [id, node_a, node_b] or a mapping");
@@ -304,18 +313,8 @@ struct Parser {
     GroupSpec s{name, v, -1, -1, {}, {}};
     if (v["material"]) s.material = material_of(v["material"], w);
     if (v["section"]) s.section = section_of(v["section"], w);
-    if (v["type"]) {
-      ElementType t;
-      const std::string tn = ctx.string(v["type"], w + " type");
-      if (!parse_element_type(tn, &t) || t == ElementType::PointMass || t == ElementType::Spring)
-        fail(v["type"], w + ": unknown element type '" + tn + "' (known: beam2d, frame2d, frame3d)");
-      s.type = t;
-    }
-    if (v["orientation"]) {
-      const auto o = ctx.numbers(v["orientation"], w + " orientation");
-      if (o.size() != 3) fail(v["orientation"], w + ": orientation must be [x, y, z]");
-      s.orientation = Eigen::Vector3d(o[0], o[1], o[2]);
-    }
+    if (v["type"]) s.type = member_type(v["type"], w);
+    if (v["orientation"]) s.orientation = orientation_of(v["orientation"], w);
     if (v["support"]) {
       const DofMask m = fix_mask(v["support"], w + " support");
       for (int id : g->nodes) model.restrain(id, m);
@@ -475,10 +474,7 @@ Model parse_model(const YAML::Node& node, const YamlCtx& ctx, const std::string&
                                 "groups"});
   Parser p{ctx, {}, {}, {}, {}, {}, {}, {}, ElementType::Frame2D, false, dir, notes, {}, {}, {}, {}};
   if (node["element"]) {
-    const std::string t = ctx.string(node["element"], "model element");
-    if (!parse_element_type(t, &p.default_type) || p.default_type == ElementType::PointMass ||
-        p.default_type == ElementType::Spring)
-      ctx.fail(node["element"], "model: unknown element type '" + t + "' (known: beam2d, frame2d, frame3d)");
+    p.default_type = p.member_type(node["element"], "model");
     p.have_default_type = true;
   }
   if (node["mass"]) {

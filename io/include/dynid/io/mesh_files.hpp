@@ -71,9 +71,4 @@ MeshData read_abaqus(const std::string& path);
 /// Reads a mesh file by its extension: .msh (Gmsh) or .inp (Abaqus).
 MeshData read_mesh_file(const std::string& path);
 
-namespace internal {
-/// The whole file as bytes; throws InputError naming the file if it cannot be read.
-std::string read_file_bytes(const std::string& path);
-}  // namespace internal
-
 }  // namespace dynid
