@@ -22,6 +22,8 @@ int run_modal(const ModalArgs& a, const GlobalOptions& g) {
   Case c = load_case(a.case_path);
   for (const std::string& w : c.model.warnings())
     if (!g.quiet) fmt::print(stderr, "dynid modal: warning: {}: {}\n", c.path, w);
+  for (const std::string& n : c.notes)
+    if (!g.quiet) fmt::print(stderr, "dynid modal: note: {}\n", n);
   EigenOptions opt = c.analysis.eigen_options();
   if (a.modes > 0) {
     opt.num_modes = a.modes;

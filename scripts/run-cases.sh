@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Runs dynid on every bundled case (cases/**/*.yaml): `detect` for cases with a detect: section, `modal`
-# otherwise. Results (JSON, and plots for detect) go to out/ (override with DYNID_OUT). This is the "main job"
-# of the README's first command; each case folder's README says what the case shows.
+# Runs dynid on every bundled case (cases/**/*.yaml, found below, so new case folders need no entry here; this
+# includes the mesh-file cases paper-frame-gmsh and paper-frame-abaqus, whose models come from frame.msh and
+# frame.inp): `detect` for cases with a detect: section, `modal` otherwise. Results (JSON, and plots for
+# detect) go to out/ (override with DYNID_OUT). This is the "main job" of the README's first command; each case
+# folder's README says what the case shows.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 dynid=${DYNID_BIN:-$here/build/cli/dynid}

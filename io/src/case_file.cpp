@@ -7,6 +7,7 @@
 #include "dynid/engine/modal.hpp"
 #include "dynid/io/modal_data_io.hpp"
 #include "internal/case_util.hpp"
+#include "internal/file_util.hpp"
 #include "internal/model_yaml.hpp"
 
 namespace dynid {
@@ -252,7 +253,7 @@ Case parse_case(const std::string& text, const std::string& name, const std::str
     YamlCtx mctx = ctx;
     std::string mdir = dir;
     const YAML::Node m = model_node(root, &mctx, &mdir, 0);
-    c.model = internal::parse_model(m, mctx);
+    c.model = internal::parse_model(m, mctx, mdir, &c.notes);
   }
   c.analysis = parse_analysis(root["analysis"], ctx);
   if (root["detect"]) c.detect = parse_detect(root["detect"], ctx, c.model, dir);
@@ -298,11 +299,7 @@ ModalData update_measured_data(const Case& c) {
 
 Case load_case(const std::string& path) {
   const std::string file = resolve_case_path(path);
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file + ": cannot open for reading");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parse_case(ss.str(), file, fs::path(file).parent_path().string());
+  return parse_case(internal::read_file_bytes(file), file, fs::path(file).parent_path().string());
 }
 
 }  // namespace dynid

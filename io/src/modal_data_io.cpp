@@ -1,11 +1,10 @@
 #include "dynid/io/modal_data_io.hpp"
 
 #include <cctype>
-#include <fstream>
-#include <sstream>
 
 #include "dynid/io/output.hpp"
 #include "dynid/mesh/error.hpp"
+#include "internal/file_util.hpp"
 
 namespace dynid {
 
@@ -104,11 +103,7 @@ ModalData parse_modal_data_json(const std::string& text, const std::string& name
 }
 
 ModalData read_modal_data(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open for reading");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parse_modal_data_json(ss.str(), path);
+  return parse_modal_data_json(internal::read_file_bytes(path), path);
 }
 
 nlohmann::ordered_json modal_data_json(const ModalData& d) {

@@ -1,11 +1,15 @@
 // The `model:` section of a case file. See docs/case-file.md for the annotated reference.
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <regex>
 #include <set>
 
+#include "dynid/io/mesh_files.hpp"
 #include "dynid/mesh/generators.hpp"
+#include "internal/case_util.hpp"
 #include "internal/model_yaml.hpp"
+#include "internal/sections.hpp"
 
 namespace dynid::internal {
 
@@ -20,6 +24,11 @@ struct Parser {
   std::string default_material, default_section;
   ElementType default_type = ElementType::Frame2D;
   bool have_default_type = false;
+  std::string dir;                          // the case file's folder (mesh file paths resolve against it)
+  std::vector<std::string>* notes = nullptr;  // remarks for the caller (mesh-file content not used)
+  std::map<int, std::string> element_where;   // element id -> "file:line" in a mesh file
+  MeshData mesh;                              // model.file, if given
+  std::vector<int> file_material, file_section;  // mesh material/section index -> model index
 
   [[noreturn]] void fail(const YAML::Node& n, const std::string& m) const { ctx.fail(n, m); }
 
@@ -62,20 +71,14 @@ struct Parser {
         if (!r["width"] || !r["depth"]) fail(r, w + ": rectangle needs width and depth (depth lies in the bending plane)");
         const double b = ctx.number(r["width"], w + " width"), h = ctx.number(r["depth"], w + " depth");
         if (b <= 0 || h <= 0) fail(r, w + ": rectangle width and depth must be > 0");
-        s.A = b * h;
-        s.Iz = b * h * h * h / 12.0;
-        s.Iy = h * b * b * b / 12.0;
-        const double a = std::max(b, h), t = std::min(b, h);
-        s.J = a * t * t * t * (1.0 / 3.0 - 0.21 * (t / a) * (1.0 - std::pow(t / a, 4) / 12.0));
+        s = rectangle_section(name, b, h);
       } else if (v["circle"]) {
         const YAML::Node& c = v["circle"];
         ctx.require_map(c, w + " circle");
         ctx.only_keys(c, w + " circle", {"diameter"});
         const double d = ctx.number(c["diameter"], w + " diameter");
         if (d <= 0) fail(c, w + ": diameter must be > 0");
-        s.A = M_PI * d * d / 4.0;
-        s.Iy = s.Iz = M_PI * std::pow(d, 4) / 64.0;
-        s.J = 2.0 * s.Iz;
+        s = pipe_section(name, d / 2, d / 2);
       }
       if (v["A"]) s.A = ctx.number(v["A"], w + " A");
       if (v["I"]) s.Iz = ctx.number(v["I"], w + " I");
@@ -86,6 +89,21 @@ struct Parser {
       if (!(v["A"] || v["rectangle"] || v["circle"])) fail(v, w + ": area A is missing");
       sections[name] = model.add_section(s);
     }
+  }
+
+  /// A beam or frame element type: beam2d | frame2d | frame3d.
+  ElementType member_type(const YAML::Node& n, const std::string& w, const std::string& hint = "") const {
+    const std::string t = ctx.string(n, w + " type");
+    ElementType type;
+    if (!parse_element_type(t, &type) || type == ElementType::PointMass || type == ElementType::Spring)
+      fail(n, w + ": unknown element type '" + t + "' (known: beam2d, frame2d, frame3d" + hint + ")");
+    return type;
+  }
+  /// orientation: [x, y, z] (frame3d: a vector in the local x-z plane).
+  Eigen::Vector3d orientation_of(const YAML::Node& n, const std::string& w) const {
+    const auto v = ctx.numbers(n, w + " orientation");
+    if (v.size() != 3) fail(n, w + ": orientation must be [x, y, z]");
+    return Eigen::Vector3d(v[0], v[1], v[2]);
   }
 
   int material_of(const YAML::Node& n, const std::string& w) {
@@ -163,9 +181,7 @@ struct Parser {
         el.id = ctx.integer(e["id"], "element id");
         w = "element " + std::to_string(el.id);
         if (e["type"]) {
-          const std::string t = ctx.string(e["type"], w + " type");
-          if (!parse_element_type(t, &el.type) || el.type == ElementType::PointMass || el.type == ElementType::Spring)
-            fail(e["type"], w + ": unknown element type '" + t + "' (known: beam2d, frame2d, frame3d; point masses and springs have their own lists)");
+          el.type = member_type(e["type"], w, "; point masses and springs have their own lists");
         } else if (!have_default_type) {
           fail(e, w + ": no element type (give type: or model.element)");
         }
@@ -174,11 +190,7 @@ struct Parser {
         el.node_ids = {{node_ref(nd[0], w), node_ref(nd[1], w)}};
         el.material = material_of(e["material"], w);
         el.section = section_of(e["section"], w);
-        if (e["orientation"]) {
-          const auto v = ctx.numbers(e["orientation"], w + " orientation");
-          if (v.size() != 3) fail(e["orientation"], w + ": orientation must be [x, y, z]");
-          el.orientation = Eigen::Vector3d(v[0], v[1], v[2]);
-        }
+        if (e["orientation"]) el.orientation = orientation_of(e["orientation"], w);
         if (e["group"]) el.group = ctx.string(e["group"], w + " group");
       } else {
         fail(e, "element: expected [id, node_a, node_b] or a mapping");
@@ -250,6 +262,15 @@ struct Parser {
     }
   }
 
+  /// all | fixed | clamped | pinned | [ux, uy, ...]
+  DofMask fix_mask(const YAML::Node& f, const std::string& w) {
+    if (!f.IsScalar()) return dof_list(f, w);
+    const std::string s = f.Scalar();
+    if (s == "all" || s == "fixed" || s == "clamped") return kAllDofs;
+    if (s == "pinned") return kTranslations;
+    fail(f, w + ": must be all, fixed, pinned, or a list of DOFs such as [ux, uy]; got '" + s + "'");
+  }
+
   void parse_supports(const YAML::Node& n) {
     if (n.IsScalar()) {
       const std::string s = n.Scalar();
@@ -268,18 +289,113 @@ struct Parser {
         for (const auto& q : e["nodes"]) ids.push_back(node_ref(q, "support"));
       }
       if (ids.empty()) fail(e, "support: give node: N or nodes: [...]");
-      const YAML::Node& f = e["fix"];
-      DofMask m = 0;
-      if (!f) fail(e, "support: fix is missing (all, pinned, or a list such as [ux, uy])");
-      if (f.IsScalar()) {
-        const std::string s = f.Scalar();
-        if (s == "all" || s == "fixed" || s == "clamped") m = kAllDofs;
-        else if (s == "pinned") m = kTranslations;
-        else fail(f, "support: fix must be all, pinned, or a list of DOFs such as [ux, uy]; got '" + s + "'");
-      } else {
-        m = dof_list(f, "support");
-      }
+      if (!e["fix"]) fail(e, "support: fix is missing (all, pinned, or a list such as [ux, uy])");
+      const DofMask m = fix_mask(e["fix"], "support");
       for (int id : ids) model.restrain(id, m);
+    }
+  }
+
+  /// What a `groups:` entry of a mesh-file model assigns to the elements and nodes of one group.
+  struct GroupSpec {
+    std::string name;
+    YAML::Node node;
+    int material = -1, section = -1;
+    std::optional<ElementType> type;
+    std::optional<Eigen::Vector3d> orientation;
+  };
+
+  GroupSpec parse_group(const std::string& name, const YAML::Node& v, const MeshData& mesh) {
+    const std::string w = "group '" + name + "'";
+    ctx.require_map(v, w);
+    ctx.only_keys(v, w, {"section", "material", "type", "orientation", "support"});
+    const MeshGroup* g = mesh.find_group(name);
+    if (!g) fail(v, w + " is not in " + mesh.file + " (its groups: " + mesh.group_names() + ")");
+    GroupSpec s{name, v, -1, -1, {}, {}};
+    if (v["material"]) s.material = material_of(v["material"], w);
+    if (v["section"]) s.section = section_of(v["section"], w);
+    if (v["type"]) s.type = member_type(v["type"], w);
+    if (v["orientation"]) s.orientation = orientation_of(v["orientation"], w);
+    if (v["support"]) {
+      const DofMask m = fix_mask(v["support"], w + " support");
+      for (int id : g->nodes) model.restrain(id, m);
+    }
+    return s;
+  }
+
+  /// model: {file: frame.msh | frame.inp}: reads the mesh file and adds its materials and sections (Abaqus),
+  /// except those the case file defines under the same name.
+  void read_mesh(const YAML::Node& f) {
+    const std::string path = resolve(dir, ctx.string(f, "model file"));
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) fail(f, "model file: cannot open '" + path + "'");
+    mesh = read_mesh_file(path);
+    if (notes)
+      for (const std::string& s : mesh.skipped) notes->push_back(mesh.file + ": skipped " + s);
+    for (const Material& m : mesh.materials) {
+      auto it = materials.find(m.name);
+      file_material.push_back(it != materials.end() ? it->second : (materials[m.name] = model.add_material(m)));
+    }
+    for (const Section& s : mesh.sections) {
+      auto it = sections.find(s.name);
+      file_section.push_back(it != sections.end() ? it->second : (sections[s.name] = model.add_section(s)));
+    }
+  }
+
+  /// The mesh's nodes, elements and supports, with `groups: {name: {section, material, type, orientation,
+  /// support}}` applied to the mesh groups (Gmsh physical groups, Abaqus sets).
+  void build_mesh_model(const YAML::Node& groups) {
+    for (const Node& n : mesh.nodes) {
+      model.add_node(n.id, n.x);
+      node_ids.insert(n.id);
+    }
+    for (const auto& [id, m] : mesh.restraints) model.restrain(id, m);
+    // Group assignments, per element id (two groups may not give one element different values).
+    std::vector<GroupSpec> specs;
+    std::map<int, std::vector<const GroupSpec*>> by_element;
+    if (groups) {
+      ctx.require_map(groups, "groups");
+      for (const auto& kv : groups) specs.push_back(parse_group(kv.first.Scalar(), kv.second, mesh));
+      for (const GroupSpec& s : specs)
+        for (int id : mesh.find_group(s.name)->elements) by_element[id].push_back(&s);
+    }
+    for (const MeshElement& me : mesh.elements) {
+      const std::string w = "element " + std::to_string(me.id);
+      auto mfail = [&](const std::string& m) -> void { throw InputError(me.where + ": " + w + ": " + m); };
+      Element el;
+      el.id = me.id;
+      el.node_ids = me.nodes;
+      el.group = me.group;
+      el.material = me.material >= 0 ? file_material[me.material] : -1;
+      el.section = me.section >= 0 ? file_section[me.section] : -1;
+      el.orientation = me.orientation;
+      std::optional<ElementType> type = me.type;
+      const GroupSpec* from[4] = {nullptr, nullptr, nullptr, nullptr};  // material, section, type, orientation
+      for (const GroupSpec* s : by_element[me.id]) {
+        auto take = [&](int k, bool has, const char* what) {
+          if (!has) return false;
+          if (from[k]) fail(s->node, "group '" + s->name + "' and group '" + from[k]->name + "' both set the " + what + " of " + w);
+          from[k] = s;
+          return true;
+        };
+        if (take(0, s->material >= 0, "material")) el.material = s->material;
+        if (take(1, s->section >= 0, "section")) el.section = s->section;
+        if (take(2, s->type.has_value(), "type")) type = s->type;
+        if (take(3, s->orientation.has_value(), "orientation")) el.orientation = *s->orientation;
+      }
+      if (!type && have_default_type) type = default_type;
+      if (!type) mfail("no element type: give model.element (beam2d, frame2d, frame3d) or type: in one of its groups");
+      el.type = *type;
+      if (el.material < 0 && !default_material.empty()) el.material = materials.at(default_material);
+      if (el.section < 0 && !default_section.empty()) el.section = sections.at(default_section);
+      if (el.material < 0 || el.section < 0)
+        mfail(std::string("no ") + (el.material < 0 ? "material" : "section") +
+              ": assign one in the case file (model.groups.<group>.material/section, or model.defaults)");
+      if (me.type == ElementType::Frame3D && el.type == ElementType::Frame3D && el.orientation.squaredNorm() == 0)
+        mfail("no beam orientation: give the n1 direction as the second data line of its *BEAM SECTION (Abaqus's "
+              "default would be 0, 0, -1), an orientation node, or orientation: in its case-file group");
+      if (element_nodes.count(el.id) || element_where.count(el.id)) mfail("is defined twice");
+      element_where[el.id] = me.where;
+      model.add_element(el);
     }
   }
 
@@ -351,16 +467,14 @@ struct Parser {
 
 }  // namespace
 
-Model parse_model(const YAML::Node& node, const YamlCtx& ctx) {
+Model parse_model(const YAML::Node& node, const YamlCtx& ctx, const std::string& dir, std::vector<std::string>* notes) {
   ctx.require_map(node, "model");
   ctx.only_keys(node, "model", {"element", "mass", "rotary_inertia", "materials", "sections", "defaults", "nodes",
-                                "elements", "point_masses", "springs", "supports", "generate", "units"});
-  Parser p{ctx, {}, {}, {}, {}, {}, {}, {}, ElementType::Frame2D, false};
+                                "elements", "point_masses", "springs", "supports", "generate", "units", "file",
+                                "groups"});
+  Parser p{ctx, {}, {}, {}, {}, {}, {}, {}, ElementType::Frame2D, false, dir, notes, {}, {}, {}, {}};
   if (node["element"]) {
-    const std::string t = ctx.string(node["element"], "model element");
-    if (!parse_element_type(t, &p.default_type) || p.default_type == ElementType::PointMass ||
-        p.default_type == ElementType::Spring)
-      ctx.fail(node["element"], "model: unknown element type '" + t + "' (known: beam2d, frame2d, frame3d)");
+    p.default_type = p.member_type(node["element"], "model");
     p.have_default_type = true;
   }
   if (node["mass"]) {
@@ -372,6 +486,7 @@ Model parse_model(const YAML::Node& node, const YamlCtx& ctx) {
   if (node["rotary_inertia"]) p.model.set_rotary_inertia(ctx.boolean(node["rotary_inertia"], "rotary_inertia"));
   if (node["materials"]) p.parse_materials(node["materials"]);
   if (node["sections"]) p.parse_sections(node["sections"]);
+  if (node["file"]) p.read_mesh(node["file"]);
   if (node["defaults"]) {
     const YAML::Node& d = node["defaults"];
     ctx.require_map(d, "defaults");
@@ -385,7 +500,12 @@ Model parse_model(const YAML::Node& node, const YamlCtx& ctx) {
       p.section_of(d["section"], "defaults");
     }
   }
-  if (node["generate"]) {
+  if (node["groups"] && !node["file"]) ctx.fail(node["groups"], "model: groups: needs file: (a mesh file)");
+  if (node["file"]) {
+    for (const char* k : {"nodes", "elements", "generate"})
+      if (node[k]) ctx.fail(node[k], std::string("model: '") + k + "' cannot be combined with file");
+    p.build_mesh_model(node["groups"]);
+  } else if (node["generate"]) {
     for (const char* k : {"nodes", "elements"})
       if (node[k]) ctx.fail(node[k], std::string("model: '") + k + "' cannot be combined with generate");
     p.parse_generate(node["generate"]);
@@ -401,7 +521,7 @@ Model parse_model(const YAML::Node& node, const YamlCtx& ctx) {
   if (node["point_masses"]) p.parse_point_masses(node["point_masses"]);
   if (node["springs"]) p.parse_springs(node["springs"]);
   if (node["supports"]) p.parse_supports(node["supports"]);
-  else if (!node["generate"]) ctx.fail(node, "model: supports are missing (a list of supports, or 'free' for a free-free structure)");
+  else if (!node["generate"] && !node["file"]) ctx.fail(node, "model: supports are missing (a list of supports, or 'free' for a free-free structure)");
   try {
     p.model.finalize();
   } catch (const InputError& e) {
@@ -412,6 +532,8 @@ Model parse_model(const YAML::Node& node, const YamlCtx& ctx) {
     if (std::regex_search(msg, m, re)) {
       auto it = p.element_nodes.find(std::stoi(m[2]));
       if (it != p.element_nodes.end()) ctx.fail(it->second, msg);
+      auto mesh = p.element_where.find(std::stoi(m[2]));
+      if (mesh != p.element_where.end()) throw InputError(mesh->second + ": " + msg);
     }
     ctx.fail(node, msg);
   }

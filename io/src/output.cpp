@@ -6,12 +6,22 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 
 #include "dynid/mesh/error.hpp"
+#include "internal/file_util.hpp"
 
 namespace dynid {
 
 namespace fs = std::filesystem;
+
+std::string internal::read_file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open for reading");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
 
 void write_file_atomic(const std::string& path, const std::string& content, bool overwrite) {
   std::error_code ec;

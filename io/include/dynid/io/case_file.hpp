@@ -3,9 +3,9 @@
 #pragma once
 
 #include <limits>
-#include <string>
-
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "dynid/engine/detect.hpp"
 #include "dynid/engine/identify.hpp"
@@ -70,6 +70,7 @@ struct Case {
   std::string dir;          ///< its folder (relative paths in the case resolve against it)
   std::string name, description;
   Model model;              ///< finalized
+  std::vector<std::string> notes;  ///< remarks on reading the model (mesh-file content that was skipped)
   AnalysisSpec analysis;
   std::optional<DetectSpec> detect;
   std::optional<UpdateSpec> update;
