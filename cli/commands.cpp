@@ -31,6 +31,7 @@ void register_commands(CLI::App& app, GlobalOptions& g) {
   register_modal(app, g);
   register_detect(app, g);
   register_update(app, g);
+  register_info(app, g);
 }
 
 }  // namespace dynid::cli

@@ -23,5 +23,6 @@ void register_commands(CLI::App& app, GlobalOptions& g);
 void register_modal(CLI::App& app, GlobalOptions& g);
 void register_detect(CLI::App& app, GlobalOptions& g);
 void register_update(CLI::App& app, GlobalOptions& g);
+void register_info(CLI::App& app, GlobalOptions& g);
 
 }  // namespace dynid::cli
