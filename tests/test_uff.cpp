@@ -106,12 +106,21 @@ Uff58 Synthetic58(bool complex, bool even, int n) {
 
 // ---- the shared sample files --------------------------------------------------------------------------------------
 
+/// Reads a sample and checks its dataset types and first lines.
+UffFile ReadSample(const std::string& name, const std::vector<int>& types, const std::vector<int>& lines) {
+  const UffFile f = read_uff(UffDir() + name);
+  EXPECT_EQ(f.datasets.size(), types.size());
+  for (std::size_t k = 0; k < std::min(types.size(), f.datasets.size()); ++k) {
+    EXPECT_EQ(f.datasets[k].type, types[k]) << "dataset " << k;
+    EXPECT_EQ(f.datasets[k].first_line, lines[k]) << "dataset " << k;
+  }
+  return f;
+}
+
 TEST(UffSamples, Ascii58TimeResponse) {
   REQUIRE_DIR(UffDir());
-  const UffFile f = read_uff(UffDir() + "Sample_UFF58_ascii.uff");
+  const UffFile f = ReadSample("Sample_UFF58_ascii.uff", {58}, {1});
   ASSERT_EQ(f.datasets.size(), 1u);
-  EXPECT_EQ(f.datasets[0].type, 58);
-  EXPECT_EQ(f.datasets[0].first_line, 1);
   const Uff58& d = As58(f.datasets[0]);
   EXPECT_FALSE(d.binary);
   EXPECT_EQ(d.function_type, 1);
@@ -134,7 +143,7 @@ TEST(UffSamples, Ascii58TimeResponse) {
 
 TEST(UffSamples, Binary58SingleLittleEndian) {
   REQUIRE_DIR(UffDir());
-  const UffFile f = read_uff(UffDir() + "Sample_UFF58b_bin.uff");
+  const UffFile f = ReadSample("Sample_UFF58b_bin.uff", {58}, {1});
   ASSERT_EQ(f.datasets.size(), 1u);
   const Uff58& d = As58(f.datasets[0]);
   EXPECT_TRUE(d.binary);
@@ -151,7 +160,7 @@ TEST(UffSamples, Binary58SingleLittleEndian) {
 
 TEST(UffSamples, Binary58DoubleAndRecording) {
   REQUIRE_DIR(UffDir());
-  const UffFile f = read_uff(UffDir() + "binary8byte.uff");
+  const UffFile f = ReadSample("binary8byte.uff", {58}, {1});
   ASSERT_EQ(f.datasets.size(), 1u);
   const Uff58& d = As58(f.datasets[0]);
   EXPECT_TRUE(d.binary);
@@ -172,14 +181,9 @@ TEST(UffSamples, Binary58DoubleAndRecording) {
 
 TEST(UffSamples, TestLabUnitsNodesAndSkipped) {
   REQUIRE_DIR(UffDir());
-  const UffFile f = read_uff(UffDir() + "TestLab 161 164 18 15 82.uff");
-  const std::vector<int> types = {151, 164, 18, 15, 82, 82, 82};
-  const std::vector<int> lines = {1, 11, 17, 164, 203, 210, 219};
-  ASSERT_EQ(f.datasets.size(), types.size());
-  for (std::size_t k = 0; k < types.size(); ++k) {
-    EXPECT_EQ(f.datasets[k].type, types[k]);
-    EXPECT_EQ(f.datasets[k].first_line, lines[k]);
-  }
+  const UffFile f = ReadSample("TestLab 161 164 18 15 82.uff", {151, 164, 18, 15, 82, 82, 82},
+                                {1, 11, 17, 164, 203, 210, 219});
+  ASSERT_EQ(f.datasets.size(), 7u);
   EXPECT_TRUE(std::holds_alternative<UffSkipped>(f.datasets[0].data));
   EXPECT_TRUE(std::holds_alternative<UffSkipped>(f.datasets[2].data));
   EXPECT_TRUE(std::holds_alternative<UffSkipped>(f.datasets[4].data));
@@ -199,12 +203,8 @@ TEST(UffSamples, TestLabUnitsNodesAndSkipped) {
 
 TEST(UffSamples, OrosNodesAndElements) {
   REQUIRE_DIR(UffDir());
-  const UffFile f = read_uff(UffDir() + "mesh_Oros-modal_uff15_uff2412.uff");
+  const UffFile f = ReadSample("mesh_Oros-modal_uff15_uff2412.uff", {18, 15, 2412}, {1, 8, 107});
   ASSERT_EQ(f.datasets.size(), 3u);
-  EXPECT_EQ(f.datasets[0].type, 18);
-  EXPECT_EQ(f.datasets[1].type, 15);
-  EXPECT_EQ(f.datasets[2].type, 2412);
-  EXPECT_EQ(f.datasets[2].first_line, 107);
   const UffNodes& n = std::get<UffNodes>(f.datasets[1].data);
   ASSERT_EQ(n.nodes.size(), 96u);  // lines 10..105
   EXPECT_EQ(n.nodes[0].id, 7);

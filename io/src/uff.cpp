@@ -607,15 +607,23 @@ void put_real(std::string* s, double v) {
   *s += b;
 }
 
-void put_line(std::string* s, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
-void put_line(std::string* s, const char* fmt, ...) {
+/// printf-formatted text appended to s.
+void put_text(std::string* s, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+void put_text(std::string* s, const char* fmt, ...) {
   char b[256];
   va_list ap;
   va_start(ap, fmt);
   std::vsnprintf(b, sizeof b, fmt, ap);
   va_end(ap);
   *s += b;
-  *s += '\n';
+}
+
+/// The "-1" and type lines that open an ASCII dataset.
+std::string open_dataset(int type) {
+  std::string s;
+  put_text(&s, "%6d\n", -1);
+  put_text(&s, "%6d\n", type);
+  return s;
 }
 
 /// Text fields are cut to their width and must not hold line breaks.
@@ -627,7 +635,7 @@ std::string text_field(const std::string& s, std::size_t width) {
 }
 
 void put_ids(std::string* s, const std::array<std::string, 5>& id) {
-  for (const std::string& l : id) put_line(s, "%-80s", text_field(l, 80).c_str());
+  for (const std::string& l : id) put_text(s, "%-80s\n", text_field(l, 80).c_str());
 }
 
 /// Values in lines of 3.
@@ -639,7 +647,7 @@ void put_values(std::string* s, const std::vector<double>& v) {
 }
 
 void put_axis(std::string* s, const UffAxis& a) {
-  put_line(s, "%10d%5d%5d%5d %-20s %-20s", a.data_type, a.length_exp, a.force_exp, a.temperature_exp,
+  put_text(s, "%10d%5d%5d%5d %-20s %-20s\n", a.data_type, a.length_exp, a.force_exp, a.temperature_exp,
            text_field(a.label, 20).c_str(), text_field(a.unit, 20).c_str());
 }
 
@@ -665,24 +673,20 @@ std::string format_uff58(const Uff58& d) {
     v.push_back(d.y[k].real());
     if (w.is_complex()) v.push_back(d.y[k].imag());
   }
-  std::string s;
-  put_line(&s, "%6d", -1);
-  if (d.binary)
-    put_line(&s, "%6db%6d%6d%12d%12lld%6d%6d%12d%12d", 58, 1, 2, 11, static_cast<long long>(v.size() * 8), 0, 0, 0, 0);
-  else
-    put_line(&s, "%6d", 58);
+  std::string s = d.binary ? "" : open_dataset(58);
+  if (d.binary) {
+    put_text(&s, "%6d\n", -1);
+    put_text(&s, "%6db%6d%6d%12d%12lld%6d%6d%12d%12d\n", 58, 1, 2, 11, static_cast<long long>(v.size() * 8), 0, 0, 0, 0);
+  }
   put_ids(&s, d.id);
-  put_line(&s, "%5d%10d%5d%10d %-10s%10d%4d %-10s%10d%4d", d.function_type, d.function_id, d.version, d.load_case,
+  put_text(&s, "%5d%10d%5d%10d %-10s%10d%4d %-10s%10d%4d\n", d.function_type, d.function_id, d.version, d.load_case,
            text_field(d.response_name, 10).c_str(), d.response_node, d.response_direction,
            text_field(d.reference_name, 10).c_str(), d.reference_node, d.reference_direction);
-  std::string r7;
-  char b[64];
-  std::snprintf(b, sizeof b, "%10d%10lld%10d", w.ordinate_type, static_cast<long long>(n), w.even ? 1 : 0);
-  r7 = b;
-  put_real(&r7, w.even ? d.x_min : 0.0);
-  put_real(&r7, w.even ? d.dx : 0.0);
-  put_real(&r7, d.z_value);
-  s += r7 + "\n";
+  put_text(&s, "%10d%10lld%10d", w.ordinate_type, static_cast<long long>(n), w.even ? 1 : 0);
+  put_real(&s, w.even ? d.x_min : 0.0);
+  put_real(&s, w.even ? d.dx : 0.0);
+  put_real(&s, d.z_value);
+  s += '\n';
   put_axis(&s, d.abscissa);
   put_axis(&s, d.ordinate);
   put_axis(&s, d.denominator);
@@ -691,29 +695,23 @@ std::string format_uff58(const Uff58& d) {
     for (double x : v) put_le_double(&s, x);
   else
     put_values(&s, v);
-  put_line(&s, "%6d", -1);
+  put_text(&s, "%6d\n", -1);
   return s;
 }
 
 std::string format_uff55(const Uff55& d) {
   if (d.values.rows() != static_cast<Eigen::Index>(d.nodes.size()) || d.values.cols() != d.values_per_node)
     throw InputError("UFF 55 '" + d.id[0] + "': values must be nodes x values per node");
-  std::string s;
-  put_line(&s, "%6d", -1);
-  put_line(&s, "%6d", 55);
+  std::string s = open_dataset(55);
   put_ids(&s, d.id);
-  put_line(&s, "%10d%10d%10d%10d%10d%10d", d.model_type, d.analysis_type, d.data_characteristic, d.data_type_code,
+  put_text(&s, "%10d%10d%10d%10d%10d%10d\n", d.model_type, d.analysis_type, d.data_characteristic, d.data_type_code,
            d.complex ? 5 : 2, d.values_per_node);
-  for (int i : d.record7) {
-    char b[16];
-    std::snprintf(b, sizeof b, "%10d", i);
-    s += b;
-  }
+  for (int i : d.record7) put_text(&s, "%10d", i);
   s += '\n';
   for (double r : d.record8) put_real(&s, r);
   s += '\n';
   for (std::size_t i = 0; i < d.nodes.size(); ++i) {
-    put_line(&s, "%10d", d.nodes[i]);
+    put_text(&s, "%10d\n", d.nodes[i]);
     std::vector<double> v;
     for (int j = 0; j < d.values_per_node; ++j) {
       v.push_back(d.values(static_cast<Eigen::Index>(i), j).real());
@@ -721,37 +719,31 @@ std::string format_uff55(const Uff55& d) {
     }
     put_values(&s, v);
   }
-  put_line(&s, "%6d", -1);
+  put_text(&s, "%6d\n", -1);
   return s;
 }
 
 std::string format_uff15(const UffNodes& d) {
-  std::string s;
-  put_line(&s, "%6d", -1);
-  put_line(&s, "%6d", 15);
+  std::string s = open_dataset(15);
   for (const UffNode& n : d.nodes) {
-    char b[64];
-    std::snprintf(b, sizeof b, "%10d%10d%10d%10d", n.id, n.definition_cs, n.displacement_cs, n.colour);
-    s += b;
+    put_text(&s, "%10d%10d%10d%10d", n.id, n.definition_cs, n.displacement_cs, n.colour);
     for (int k = 0; k < 3; ++k) put_real(&s, n.x[k]);
     s += '\n';
   }
-  put_line(&s, "%6d", -1);
+  put_text(&s, "%6d\n", -1);
   return s;
 }
 
 std::string format_uff164(const UffUnits& u) {
-  std::string s;
-  put_line(&s, "%6d", -1);
-  put_line(&s, "%6d", 164);
-  put_line(&s, "%10d%-20s%10d", u.code, text_field(u.description, 20).c_str(), u.temperature_mode);
+  std::string s = open_dataset(164);
+  put_text(&s, "%10d%-20s%10d\n", u.code, text_field(u.description, 20).c_str(), u.temperature_mode);
   put_real(&s, u.length);
   put_real(&s, u.force);
   put_real(&s, u.temperature);
   s += '\n';
   put_real(&s, u.temperature_offset);
   s += '\n';
-  put_line(&s, "%6d", -1);
+  put_text(&s, "%6d\n", -1);
   return s;
 }
 
