@@ -70,11 +70,43 @@ FrfData merge_frfs(std::vector<FrfData> sets) {
   return out;
 }
 
-std::string describe_mode(const IdentifiedMode& m, bool lscf) {
-  if (!lscf) return m.mpc >= 0.9 ? "" : "complex (MPC < 0.9): check closely spaced modes or noise";
-  if (m.contribution >= 0.1) return "dominant";
-  if (m.contribution >= 0.01) return "minor mode";
-  return "weak (< 1 % of the strongest peak): a local or noise mode";
+std::string describe_mode(const IdentificationSummary& s, std::size_t k) {
+  const IdentifiedMode& m = s.modes[k];
+  if (m.mpc < 0.5) return fmt::format("complex shape (MPC {:.2f}): not a normal mode; noise or a mathematical pole", m.mpc);
+  if (m.twin_of >= 0)
+    return fmt::format("same shape as mode {} (MAC {:.3f}) at {:+.1f} % frequency: a split pair (the mode in a second plane) or a twin",
+                       m.twin_of + 1, m.twin_mac, 100 * (m.frequency_hz / s.modes[m.twin_of].frequency_hz - 1));
+  std::string w = m.mpc < 0.9 ? fmt::format(", complex (MPC {:.2f})", m.mpc) : "";
+  if (s.method != "lscf") return w.empty() ? "" : w.substr(2);
+  if (m.contribution >= 0.1) return "dominant" + w;
+  if (m.contribution >= 0.01) return "minor mode" + w;
+  return "weak (< 1 % of the strongest peak): a local or noise mode" + w;
+}
+
+// A magnitude spectrum (e.g. a LabVIEW dB spectrum, no phase): peak picking only.
+int report_spectrum_peaks(const TextTable& t, const std::vector<double>& band, const GlobalOptions& g) {
+  const double lo = band.empty() ? 0.0 : band[0], hi = band.empty() ? 0.0 : band[1];
+  for (Eigen::Index c = 0; c < t.columns.cols(); ++c) {
+    Eigen::VectorXd db = t.columns.col(c);
+    const bool is_db = db.minCoeff() < 0;  // dB spectra go negative; linear magnitudes do not
+    if (!is_db) db = (20 * db.array().max(1e-300).log10()).matrix();
+    std::vector<SpectrumPeak> peaks = spectrum_peaks(t.x, db, lo, hi, 20.0);
+    if (peaks.size() > 12) peaks.resize(12);
+    std::sort(peaks.begin(), peaks.end(), [](const SpectrumPeak& a, const SpectrumPeak& b) { return a.frequency_hz < b.frequency_hz; });
+    if (!g.quiet) {
+      fmt::print("dynid identify: {} — a magnitude spectrum (no phase): peaks standing >= 20 dB above their surroundings\n", t.source);
+      fmt::print("  column '{}' ({} lines, step {:.5g} Hz{})\n", c < static_cast<Eigen::Index>(t.names.size()) ? t.names[c] : "", t.x.size(), t.dx,
+                 is_db ? ", dB" : ", converted to dB");
+      double top = -1e300;
+      for (const SpectrumPeak& p : peaks) top = std::max(top, p.level_db);
+      fmt::print("  peak  frequency [Hz]  level [dB]  below strongest [dB]  prominence [dB]\n");
+      for (std::size_t k = 0; k < peaks.size(); ++k)
+        fmt::print("  {:4d}  {:<14.5g}  {:<10.4g}  {:<20.3g}  {:.4g}{}\n", k + 1, peaks[k].frequency_hz, peaks[k].level_db, top - peaks[k].level_db,
+                   peaks[k].prominence_db, top - peaks[k].level_db > 20 ? "  (weak)" : "");
+      fmt::print("  (frequencies only: damping and shapes need FRFs or time histories)\n");
+    }
+  }
+  return 0;
 }
 
 int run_identify(const IdentifyArgs& a, const GlobalOptions& g) {
@@ -118,7 +150,8 @@ int run_identify(const IdentifyArgs& a, const GlobalOptions& g) {
       } else if (d.kind == TestData::Kind::kTimeHistory) {
         recs.push_back(std::move(d.recording));
       } else {
-        throw InputError(f + ": a spectrum cannot be identified from; give time histories, FRFs (--frf for text files) or UFF 58");
+        if (a.files.size() > 1) throw InputError(f + ": a magnitude spectrum is identified on its own (peak picking); give it alone");
+        return report_spectrum_peaks(d.table, a.band, g);
       }
     }
   }
@@ -174,7 +207,7 @@ int run_identify(const IdentifyArgs& a, const GlobalOptions& g) {
       const IdentifiedMode& m = s.modes[k];
       fmt::print("  {:4d}  {:<14.6g}  ({:<7.2g})  {:<11.4g}  ({:<6.2g})  {:.4f}  {:5d}  {}  {}\n", k + 1, m.frequency_hz, m.frequency_std_hz,
                  100 * m.damping_ratio, 100 * m.damping_std, m.mpc, m.poles, method == "lscf" ? fmt::format("{:12.3f}", m.contribution) : "",
-                 describe_mode(m, method == "lscf"));
+                 describe_mode(s, k));
     }
     if (s.modes.empty()) fmt::print("  no stable physical poles in the band: widen the band or raise the maximum order\n");
     fmt::print("  wrote {}, {}{}\n", json, md.frequencies_hz.size() ? uff + ", " : "", png);

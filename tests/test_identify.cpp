@@ -2,6 +2,7 @@
 // (simulate a test of a model, identify the modes back, compare with the model's modes).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "dynid/engine/correlation.hpp"
@@ -9,6 +10,7 @@
 #include "dynid/engine/identify.hpp"
 #include "dynid/engine/virtual_test.hpp"
 #include "dynid/io/case_file.hpp"
+#include "dynid/io/test_data.hpp"
 #include "test_util.hpp"
 
 namespace dynid {
@@ -123,6 +125,102 @@ TEST(VirtualTest, FrameAmbientRoundTrip) {
   io.band_hi_hz = 8;
   const IdentificationSummary id = identify_ssi(t.recordings[0], io);
   expect_identified(t.modes, id, 0.3, 8, 0.005, 0.2, 0.99);
+}
+
+}  // namespace
+}  // namespace dynid
+
+// Real measurements (../shared/data/real, made by others): the tool impact test and the USC cantilever.
+namespace dynid {
+namespace {
+
+// Published beside the data (PROVENANCE.md): peak picking gave 1074, 1961, 2617 Hz with these shapes.
+TEST(RealData, ToolImpactLscfFindsThePublishedModes) {
+  DYNID_REQUIRE_SHARED();
+  const std::string dir = test::SharedDir() + "/data/real/tool-impact-test/";
+  std::vector<std::string> files;
+  std::vector<MeasuredDof> outs;
+  for (int p = 1; p <= 5; ++p) {
+    files.push_back(dir + "frf_point_" + std::to_string(p) + ".txt");
+    outs.push_back({p, Dof::UX});  // H_1p = H_p1 (reciprocity): one reference (point 1), five responses
+  }
+  const FrfData frf = read_frf_text_set(files, outs, std::vector<MeasuredDof>(5, MeasuredDof{1, Dof::UX}));
+  IdentificationOptions o;
+  o.band_lo_hz = 500;
+  o.band_hi_hz = 3500;
+  const IdentificationSummary s = identify_lscf(frf, o);
+  const double published[3] = {1074, 1961, 2617};
+  const std::vector<std::vector<double>> shapes = {{1.4111, 0.9608, 0.6749, 0.4734, 0.3435},
+                                                   {1.7165, 0.7057, 0.1830, -0.1333, -0.2136},
+                                                   {2.0023, 0.4510, -0.1414, -0.2755, -0.3013}};
+  // The three strongest modes that are not twins of a stronger one (split pairs share a shape) and have a
+  // normal-mode shape (MPC >= 0.5): the dominant modes.
+  std::vector<const IdentifiedMode*> dominant;
+  for (const IdentifiedMode& m : s.modes)
+    if (m.twin_of < 0 && m.mpc >= 0.5) dominant.push_back(&m);
+  std::sort(dominant.begin(), dominant.end(), [](auto* a, auto* b) { return a->contribution > b->contribution; });
+  ASSERT_GE(dominant.size(), 3u);
+  dominant.resize(3);
+  std::sort(dominant.begin(), dominant.end(), [](auto* a, auto* b) { return a->frequency_hz < b->frequency_hz; });
+  for (int k = 0; k < 3; ++k) {
+    // 1.5 %: the tolerance (peak picking on a 1 Hz grid against a fitted pole).
+    EXPECT_TRUE(test::RelClose(dominant[k]->frequency_hz, published[k], 0.015)) << "mode near " << published[k];
+    const Eigen::Map<const Eigen::VectorXd> p(shapes[k].data(), 5);
+    EXPECT_GE(test::Mac(dominant[k]->real_shape, p), 0.9) << "mode near " << published[k];
+    std::printf("  published %.0f Hz: identified %.1f Hz, zeta %.2f %%, MAC %.4f, MPC %.3f\n", published[k], dominant[k]->frequency_hz,
+                100 * dominant[k]->damping_ratio, test::Mac(dominant[k]->real_shape, p), dominant[k]->mpc);
+  }
+}
+
+// H1 from the raw impact record (force + acceleration at 51.2 kHz) against the supplied point-1 FRF: the
+// strongest peaks of |H| agree within 2 % (the tolerance; the supplied FRF is a receptance averaged
+// over impacts, ours one impact, converted from accelerance).
+TEST(RealData, ToolImpactH1MatchesSuppliedFrf) {
+  DYNID_REQUIRE_SHARED();
+  const std::string dir = test::SharedDir() + "/data/real/tool-impact-test/";
+  Recording r = read_time_text(dir + "impact_point1_time.txt");
+  ASSERT_EQ(r.num_channels(), 2);
+  r.channels[0].input = true;
+  r.channels[0].quantity = Quantity::kForce;
+  r.channels[0].dof = {1, Dof::UX};
+  r.channels[1].input = false;
+  r.channels[1].quantity = Quantity::kAcceleration;
+  r.channels[1].dof = {1, Dof::UX};
+  FrfOptions fo;
+  fo.max_frequency_hz = 5000;
+  const FrfData h = convert_frf(estimate_frf({r}, fo), Quantity::kDisplacement);
+  const FrfData ref = read_frf_text(dir + "frf_point_1.txt", {1, Dof::UX}, {1, Dof::UX});
+  auto peaks = [](const FrfData& d) {
+    Eigen::VectorXd db(d.frequency_hz.size());
+    for (Eigen::Index k = 0; k < db.size(); ++k) db[k] = 20 * std::log10(std::abs(d.H(k, 0)) + 1e-300);
+    std::vector<SpectrumPeak> p = spectrum_peaks(d.frequency_hz, db, 500, 3500, 3.0);
+    std::sort(p.begin(), p.end(), [](auto& a, auto& b) { return a.level_db > b.level_db; });
+    p.resize(std::min<std::size_t>(p.size(), 3));
+    std::sort(p.begin(), p.end(), [](auto& a, auto& b) { return a.frequency_hz < b.frequency_hz; });
+    return p;
+  };
+  const std::vector<SpectrumPeak> a = peaks(h), b = peaks(ref);
+  ASSERT_EQ(a.size(), 3u);
+  ASSERT_EQ(b.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_TRUE(test::RelClose(a[k].frequency_hz, b[k].frequency_hz, 0.02)) << "peak " << k + 1;
+    std::printf("  peak %d: H1 from the raw record %.1f Hz, supplied FRF %.1f Hz\n", k + 1, a[k].frequency_hz, b[k].frequency_hz);
+  }
+}
+
+// The USC cantilever's impulse spectrum (LabVIEW, dB, 0.0853 Hz lines): its three strongest peaks are the
+// documented 6.6, 41.4 and 117.9 Hz within 1 % (the tolerance; parabolic interpolation on the dB lines).
+TEST(RealData, CantileverSpectrumPeaks) {
+  DYNID_REQUIRE_SHARED();
+  const LvmFile f = read_lvm(test::SharedDir() + "/data/real/usc-cantilever-ds4/FFT_data.lvm");
+  ASSERT_TRUE(f.spectrum);
+  std::vector<SpectrumPeak> p = spectrum_peaks(f.table.x, f.table.columns.col(0), 1, 200, 20.0);
+  std::sort(p.begin(), p.end(), [](auto& a, auto& b) { return a.level_db > b.level_db; });
+  ASSERT_GE(p.size(), 3u);
+  p.resize(3);
+  std::sort(p.begin(), p.end(), [](auto& a, auto& b) { return a.frequency_hz < b.frequency_hz; });
+  const double documented[3] = {6.6, 41.4, 117.9};
+  for (int k = 0; k < 3; ++k) EXPECT_TRUE(test::RelClose(p[k].frequency_hz, documented[k], 0.01)) << p[k].frequency_hz;
 }
 
 }  // namespace

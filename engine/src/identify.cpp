@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <random>
 
 #include "dynid/engine/frf.hpp"
@@ -75,22 +76,53 @@ std::vector<std::pair<int, int>> stabilize_and_select(const std::vector<std::vec
       s.poles.push_back(sp);
       where.emplace_back(static_cast<int>(j), static_cast<int>(p));
     }
-  // Candidates: physical and stable in every sense; clusters by chained relative frequency gaps.
+  // Candidates: physical poles stable in frequency and vector (damping estimates scatter more on real data; a
+  // cluster's damping is the median over its orders); clusters by chained relative frequency gaps.
   std::vector<int> cand;
   for (std::size_t i = 0; i < s.poles.size(); ++i)
-    if (s.poles[i].physical && s.poles[i].stable()) cand.push_back(static_cast<int>(i));
+    if (s.poles[i].physical && s.poles[i].stable_frequency && s.poles[i].stable_vector) cand.push_back(static_cast<int>(i));
+  // Seeded clustering: the candidate with the most candidates within +-tol (relative frequency) seeds a cluster,
+  // which takes from every order the unassigned candidate nearest the seed within that window; repeat. Windows
+  // cannot chain neighbouring modes together, and a cluster holds at most one pole per order.
   std::sort(cand.begin(), cand.end(), [&](int a, int b) { return s.poles[a].frequency_hz < s.poles[b].frequency_hz; });
+  std::vector<char> used(cand.size(), 0);
   std::vector<std::vector<int>> clusters;
-  for (int i : cand) {
-    if (!clusters.empty()) {
-      const StabilizationPole& last = s.poles[clusters.back().back()];
-      if (s.poles[i].frequency_hz - last.frequency_hz <= o.cluster_tolerance * s.poles[i].frequency_hz) {
-        clusters.back().push_back(i);
-        continue;
-      }
+  const double tol = o.cluster_tolerance;
+  std::vector<double> fc(cand.size());
+  for (std::size_t a = 0; a < cand.size(); ++a) fc[a] = s.poles[cand[a]].frequency_hz;
+  std::vector<int> prefix(cand.size() + 1);
+  for (;;) {
+    // Unused candidates within +-tol of each one, by prefix sums over the sorted frequencies (two pointers).
+    for (std::size_t a = 0; a < cand.size(); ++a) prefix[a + 1] = prefix[a] + (used[a] ? 0 : 1);
+    int seed = -1, best = 0;
+    std::size_t lo = 0, hi = 0;
+    for (std::size_t a = 0; a < cand.size(); ++a) {
+      while (fc[lo] < fc[a] * (1 - tol)) ++lo;
+      while (hi < cand.size() && fc[hi] <= fc[a] * (1 + tol)) ++hi;
+      const int count = prefix[hi] - prefix[lo];
+      if (!used[a] && count > best) best = count, seed = static_cast<int>(a);
     }
-    clusters.push_back({i});
+    if (seed < 0) break;
+    const double f0 = fc[seed];
+    std::size_t w0 = static_cast<std::size_t>(seed), w1 = static_cast<std::size_t>(seed) + 1;
+    while (w0 > 0 && fc[w0 - 1] >= f0 * (1 - tol)) --w0;
+    while (w1 < cand.size() && fc[w1] <= f0 * (1 + tol)) ++w1;
+    std::map<int, std::size_t> nearest;  // order -> candidate nearest the seed
+    for (std::size_t b = w0; b < w1; ++b) {
+      if (used[b]) continue;
+      const int ord = s.poles[cand[b]].order;
+      auto it = nearest.find(ord);
+      if (it == nearest.end() || std::abs(fc[b] - f0) < std::abs(fc[it->second] - f0)) nearest[ord] = b;
+    }
+    std::vector<int> members;
+    for (const auto& [ord, b] : nearest) used[b] = 1, members.push_back(cand[b]);
+    used[seed] = 1;
+    if (std::find(members.begin(), members.end(), cand[seed]) == members.end()) members.push_back(cand[seed]);
+    clusters.push_back(members);
   }
+  std::sort(clusters.begin(), clusters.end(), [&](const std::vector<int>& a, const std::vector<int>& b) {
+    return s.poles[a[0]].frequency_hz < s.poles[b[0]].frequency_hz;
+  });
   const double needed = o.min_cluster_fraction * static_cast<double>(orders.size());
   std::vector<std::pair<int, int>> chosen;
   for (const std::vector<int>& c : clusters) {
@@ -118,6 +150,19 @@ std::vector<std::pair<int, int>> stabilize_and_select(const std::vector<std::vec
     chosen.push_back(where[rep]);
   }
   return chosen;
+}
+
+// Marks modes whose shape repeats a stronger one's nearby (split pairs / duplicates).
+void mark_twins(std::vector<IdentifiedMode>& modes, bool by_contribution) {
+  for (std::size_t a = 0; a < modes.size(); ++a)
+    for (std::size_t b = 0; b < modes.size(); ++b) {
+      if (a == b || modes[a].real_shape.size() < 3) continue;
+      const double mac = complex_mac(modes[a].real_shape.cast<std::complex<double>>(), modes[b].real_shape.cast<std::complex<double>>());
+      const bool weaker = by_contribution ? modes[a].contribution < modes[b].contribution : modes[a].poles < modes[b].poles;
+      if (mac >= 0.95 && weaker && std::abs(modes[a].frequency_hz / modes[b].frequency_hz - 1) <= 0.15 &&
+          (modes[a].twin_of < 0 || mac > modes[a].twin_mac))
+        modes[a].twin_of = static_cast<int>(b), modes[a].twin_mac = mac;
+    }
 }
 
 void finish_shape(IdentifiedMode& m) {
@@ -201,6 +246,34 @@ bool IdentificationOptions::IsValid(std::string* why) const {
   if (!(cluster_tolerance > 0 && cluster_tolerance < 0.5)) return fail("the cluster tolerance must be in (0, 0.5)");
   if (block_rows < 0 || decimate < 0) return fail("block rows and decimation must be >= 0");
   return true;
+}
+
+std::vector<SpectrumPeak> spectrum_peaks(const Eigen::VectorXd& f, const Eigen::VectorXd& db, double lo, double hi, double min_prom) {
+  if (f.size() != db.size() || f.size() < 3) throw InputError("spectrum peaks: frequency and level must have the same length (>= 3)");
+  std::vector<Eigen::Index> idx;
+  for (Eigen::Index k = 0; k < f.size(); ++k)
+    if (f[k] >= lo && (hi <= 0 || f[k] <= hi)) idx.push_back(k);
+  std::vector<SpectrumPeak> out;
+  const Eigen::Index n = static_cast<Eigen::Index>(idx.size());
+  for (Eigen::Index j = 1; j + 1 < n; ++j) {
+    const Eigen::Index k = idx[j];
+    if (!(db[k] > db[idx[j - 1]] && db[k] >= db[idx[j + 1]])) continue;
+    // Prominence: walk each way to a higher line (or the band edge), tracking the minimum.
+    double left = db[k], right = db[k];
+    Eigen::Index a = j - 1;
+    for (; a >= 0 && db[idx[a]] <= db[k]; --a) left = std::min(left, db[idx[a]]);
+    Eigen::Index b = j + 1;
+    for (; b < n && db[idx[b]] <= db[k]; ++b) right = std::min(right, db[idx[b]]);
+    const double prom = db[k] - std::max(left, right);
+    if (prom < min_prom) continue;
+    // Parabola through the three lines around the maximum.
+    const double y0 = db[idx[j - 1]], y1 = db[k], y2 = db[idx[j + 1]], den = y0 - 2 * y1 + y2;
+    const double d = den != 0 ? 0.5 * (y0 - y2) / den : 0.0;
+    const double step = f[idx[j + 1]] - f[k];
+    out.push_back({f[k] + d * step, y1 - 0.25 * (y0 - y2) * d, prom});
+  }
+  std::sort(out.begin(), out.end(), [](const SpectrumPeak& x, const SpectrumPeak& y) { return x.prominence_db > y.prominence_db; });
+  return out;
 }
 
 double modal_phase_collinearity(const Eigen::VectorXcd& v) {
@@ -369,6 +442,7 @@ IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationO
       top = std::max(top, s.modes[r].contribution);
     }
     for (IdentifiedMode& m : s.modes) m.contribution = top > 0 ? m.contribution / top : 0;
+    mark_twins(s.modes, true);
   }
   s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return s;
@@ -459,6 +533,7 @@ IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOpt
     s.modes[r].shape = orders[chosen[r].first][chosen[r].second].vec;
     finish_shape(s.modes[r]);
   }
+  mark_twins(s.modes, false);
   // Background: first singular value of the output cross-spectral matrix.
   WelchOptions wo;
   int seg = 8;

@@ -19,6 +19,7 @@ nlohmann::ordered_json identification_json(const IdentificationSummary& s) {
   for (std::size_t k = 0; k < s.modes.size(); ++k) {
     modes[k]["contribution"] = s.modes[k].contribution;
     modes[k]["poles"] = s.modes[k].poles;
+    if (s.modes[k].twin_of >= 0) modes[k]["same_shape_as"] = {{"mode", s.modes[k].twin_of + 1}, {"mac", s.modes[k].twin_mac}};
   }
   j["modes"] = modes;
   return j;

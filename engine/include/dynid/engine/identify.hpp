@@ -2,10 +2,11 @@
 // covariance-driven stochastic subspace identification (output-only, from time data).
 //
 // Both run over a range of model orders, build a stabilization diagram (each pole marked stable in frequency,
-// damping and vector against the previous order), and select modes automatically: stable physical poles are
-// clustered across orders by frequency and damping, and a cluster becomes a mode when it holds a pole in at least
-// `min_cluster_fraction` of the orders. The mode's frequency and damping are the cluster medians; their standard
-// deviations across the cluster are reported as the uncertainty (the spread over model orders).
+// damping and vector against the previous order), and select modes automatically: physical poles stable in
+// frequency and vector are clustered across orders (a window of +-cluster_tolerance around the densest pole, one
+// pole per order), and a cluster becomes a mode when it holds a pole in at least `min_cluster_fraction` of the
+// orders. The mode's frequency and damping are the cluster medians; their standard deviations across the cluster
+// are reported as the uncertainty (the spread over model orders).
 #pragma once
 
 #include <complex>
@@ -26,7 +27,7 @@ struct IdentificationOptions {
   double stable_mac = 0.98;         ///< MAC of the pole's vector (participation for LSCF, shape for SSI)
   double max_damping = 0.2;         ///< poles with zeta outside (0, max_damping) are not physical
   double min_cluster_fraction = 0.4;  ///< of the orders, for a cluster to count as a mode
-  double cluster_tolerance = 0.005;   ///< relative frequency distance that links poles into a cluster
+  double cluster_tolerance = 0.01;    ///< half-width of a cluster's window (relative frequency)
   // SSI-cov.
   int block_rows = 0;  ///< i (0 = automatic from the band's lowest frequency and the maximum order)
   int decimate = 0;    ///< 0 = automatic (to about 2.5x the band's top), 1 = none
@@ -51,6 +52,10 @@ struct IdentifiedMode {
   Eigen::VectorXd real_shape;                    ///< real-normalized (best real rotation), max |.| = 1
   double mpc = 0;                                ///< modal phase collinearity (1 = a real, normal mode)
   double contribution = 0;  ///< peak FRF amplitude of the mode relative to the strongest one (LSCF), else 0
+  /// Index of a stronger mode with the same shape (MAC >= 0.95) within 15 % in frequency, or -1: a split pair
+  /// (e.g. the two bending planes of a nearly axisymmetric part seen by one sensor direction) or a duplicate.
+  int twin_of = -1;
+  double twin_mac = 0;
 };
 
 struct IdentificationSummary {
@@ -77,6 +82,15 @@ IdentificationSummary identify_lscf(const FrfData& frf, const IdentificationOpti
 /// SSI-cov on the output channels of a recording (all outputs are references; records are concatenated into
 /// the correlation estimate, each record's mean removed).
 IdentificationSummary identify_ssi(const Recording& recording, const IdentificationOptions& options);
+
+/// Peaks of a magnitude spectrum (e.g. a dB spectrum without phase): local maxima in [lo, hi] standing at
+/// least `min_prominence_db` above the higher of the two minima that separate them from higher peaks (or the
+/// band edges), located by parabolic interpolation of the dB values around the maximum line. Strongest first.
+struct SpectrumPeak {
+  double frequency_hz = 0, level_db = 0, prominence_db = 0;
+};
+std::vector<SpectrumPeak> spectrum_peaks(const Eigen::VectorXd& frequency_hz, const Eigen::VectorXd& level_db, double lo, double hi,
+                                         double min_prominence_db);
 
 /// Modal phase collinearity of a complex vector: ((e1 - e2) / (e1 + e2))^2 with e1 >= e2 the eigenvalues of the
 /// 2 x 2 covariance of its real and imaginary parts.
