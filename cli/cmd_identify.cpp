@@ -80,7 +80,7 @@ std::string describe_mode(const IdentificationSummary& s, std::size_t k) {
   if (s.method != "lscf") return w.empty() ? "" : w.substr(2);
   if (m.contribution >= 0.1) return "dominant" + w;
   if (m.contribution >= 0.01) return "minor mode" + w;
-  return "weak (< 1 % of the strongest peak): a local or noise mode" + w;
+  return "weakly excited (< 1 % of the strongest peak)" + w;
 }
 
 // A magnitude spectrum (e.g. a LabVIEW dB spectrum, no phase): peak picking only.
@@ -237,12 +237,20 @@ int run_simulate(const SimulateArgs& a, const GlobalOptions& g) {
   const VirtualTest vt = simulate_test(c.model, modes, t.options);
   progress.done();
   std::string out = !a.output.empty() ? a.output : !t.output.empty() ? t.output : (fs::path(c.dir) / (c.name + "-test.uff")).string();
-  std::vector<UffDataset> ds;
-  for (const Recording& r : vt.recordings) {
-    std::vector<UffDataset> d = uff_datasets(r, t.binary);
-    ds.insert(ds.end(), d.begin(), d.end());
+  // One file per recording (a roving hammer gives one per hit location: their channel sets differ).
+  std::vector<std::string> written;
+  std::size_t datasets = 0;
+  for (std::size_t k = 0; k < vt.recordings.size(); ++k) {
+    std::string path = out;
+    if (vt.recordings.size() > 1) {
+      const fs::path p(out);
+      path = (p.parent_path() / (p.stem().string() + "-" + to_string(t.options.inputs[k]) + p.extension().string())).string();
+    }
+    const std::vector<UffDataset> ds = uff_datasets(vt.recordings[k], t.binary);
+    datasets += ds.size();
+    write_uff(path, ds, a.force);
+    written.push_back(path);
   }
-  write_uff(out, ds, a.force);
   const std::string truth = fs::path(out).replace_extension(".truth.json").string();
   write_modal_data(truth, vt.modes, a.force);
   if (!g.quiet) {
@@ -250,7 +258,8 @@ int run_simulate(const SimulateArgs& a, const GlobalOptions& g) {
     for (const Recording& r : vt.recordings) records += r.records.size();
     fmt::print("dynid simulate-test: {} — {} sensors, {} records of {} samples at {} Hz, {} modes below Nyquist\n", c.name,
                t.options.sensors.size(), records, vt.recordings[0].records[0].rows(), t.options.sample_rate_hz, vt.modes.num_modes());
-    fmt::print("  wrote {} ({} datasets, UFF 58{}) and the simulated modes to {}\n", out, ds.size(), t.binary ? "b" : "", truth);
+    for (const std::string& w : written) fmt::print("  wrote {}\n", w);
+    fmt::print("  ({} datasets, UFF 58{}); the simulated modes (the truth) in {}\n", datasets, t.binary ? "b" : "", truth);
   }
   return 0;
 }

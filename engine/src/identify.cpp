@@ -70,17 +70,18 @@ std::vector<std::pair<int, int>> stabilize_and_select(const std::vector<std::vec
         }
         const double zq = pole_zeta(best->lambda);
         sp.stable_frequency = bd <= o.stable_frequency * sp.frequency_hz;
-        sp.stable_damping = std::abs(zq - sp.damping_ratio) <= o.stable_damping * std::max(std::abs(sp.damping_ratio), 1e-12);
+        sp.damping_change = std::abs(zq - sp.damping_ratio) / std::max(std::abs(sp.damping_ratio), 1e-12);
+        sp.stable_damping = sp.damping_change <= o.stable_damping;
         sp.stable_vector = rp.vec.size() <= 1 || complex_mac(rp.vec, best->vec) >= o.stable_mac;
       }
       s.poles.push_back(sp);
       where.emplace_back(static_cast<int>(j), static_cast<int>(p));
     }
-  // Candidates: physical poles stable in frequency and vector (damping estimates scatter more on real data; a
-  // cluster's damping is the median over its orders); clusters by chained relative frequency gaps.
+  // Candidates: physical poles stable in frequency and vector, and in damping within the looser cluster_damping
+  // (damping estimates scatter more than frequencies on real data; a cluster's damping is its median).
   std::vector<int> cand;
   for (std::size_t i = 0; i < s.poles.size(); ++i)
-    if (s.poles[i].physical && s.poles[i].stable_frequency && s.poles[i].stable_vector) cand.push_back(static_cast<int>(i));
+    if (s.poles[i].physical && s.poles[i].stable_frequency && s.poles[i].stable_vector && s.poles[i].damping_change <= o.cluster_damping) cand.push_back(static_cast<int>(i));
   // Seeded clustering: the candidate with the most candidates within +-tol (relative frequency) seeds a cluster,
   // which takes from every order the unassigned candidate nearest the seed within that window; repeat. Windows
   // cannot chain neighbouring modes together, and a cluster holds at most one pole per order.
@@ -242,6 +243,7 @@ bool IdentificationOptions::IsValid(std::string* why) const {
   if (order_step < 0) return fail("the order step must be >= 0");
   if (!(stable_frequency > 0 && stable_damping > 0 && stable_mac > 0 && stable_mac <= 1)) return fail("stability tolerances must be > 0 (MAC <= 1)");
   if (!(max_damping > 0 && max_damping < 1)) return fail("the damping limit must be in (0, 1)");
+  if (!(cluster_damping > 0)) return fail("the cluster damping tolerance must be > 0");
   if (!(min_cluster_fraction > 0 && min_cluster_fraction <= 1)) return fail("the cluster fraction must be in (0, 1]");
   if (!(cluster_tolerance > 0 && cluster_tolerance < 0.5)) return fail("the cluster tolerance must be in (0, 0.5)");
   if (block_rows < 0 || decimate < 0) return fail("block rows and decimation must be >= 0");

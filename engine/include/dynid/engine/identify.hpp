@@ -3,7 +3,7 @@
 //
 // Both run over a range of model orders, build a stabilization diagram (each pole marked stable in frequency,
 // damping and vector against the previous order), and select modes automatically: physical poles stable in
-// frequency and vector are clustered across orders (a window of +-cluster_tolerance around the densest pole, one
+// frequency and vector (and within cluster_damping in damping) are clustered across orders (a window of +-cluster_tolerance around the densest pole, one
 // pole per order), and a cluster becomes a mode when it holds a pole in at least `min_cluster_fraction` of the
 // orders. The mode's frequency and damping are the cluster medians; their standard deviations across the cluster
 // are reported as the uncertainty (the spread over model orders).
@@ -24,9 +24,10 @@ struct IdentificationOptions {
   // Stabilization criteria against the previous order.
   double stable_frequency = 0.01;   ///< relative frequency change
   double stable_damping = 0.05;     ///< relative damping change
+  double cluster_damping = 0.25;    ///< relative damping change allowed for poles that join clusters
   double stable_mac = 0.98;         ///< MAC of the pole's vector (participation for LSCF, shape for SSI)
   double max_damping = 0.2;         ///< poles with zeta outside (0, max_damping) are not physical
-  double min_cluster_fraction = 0.4;  ///< of the orders, for a cluster to count as a mode
+  double min_cluster_fraction = 0.45; ///< of the orders, for a cluster to count as a mode
   double cluster_tolerance = 0.01;    ///< half-width of a cluster's window (relative frequency)
   // SSI-cov.
   int block_rows = 0;  ///< i (0 = automatic from the band's lowest frequency and the maximum order)
@@ -41,6 +42,7 @@ struct StabilizationPole {
   bool physical = false;  ///< in the band with 0 < zeta < max_damping
   bool stable_frequency = false, stable_damping = false, stable_vector = false;
   int cluster = -1;       ///< index of the selected mode it supports, or -1
+  double damping_change = 1;  ///< |zeta - zeta_previous| / zeta against the nearest pole of the previous order
   bool stable() const { return stable_frequency && stable_damping && stable_vector; }
 };
 
