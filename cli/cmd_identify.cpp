@@ -195,7 +195,7 @@ int run_identify(const IdentifyArgs& a, const GlobalOptions& g) {
   // Refuse before writing anything if an output exists (no partial results).
   for (const std::string& p : {json, uff, png})
     if (!a.force && fs::exists(p)) throw InputError(p + ": file exists; pass --force to overwrite it");
-  if (!md.frequencies_hz.size() == 0) write_uff55(uff, md, a.force);
+  if (md.frequencies_hz.size() > 0) write_uff55(uff, md, a.force);
   write_file_atomic(json, identification_json(s).dump(1) + "\n", a.force);
   plot::save(stabilization_figure(s, "dynid identify: " + fs::path(a.files[0]).filename().string() + (a.files.size() > 1 ? " ..." : "")), png, a.force);
 
