@@ -131,9 +131,9 @@ FrfData estimate_frf(const std::vector<Recording>& recs, const FrfOptions& o) {
       const Eigen::FullPivLU<Eigen::MatrixXcd> lu(Gxx[k]);
       const bool ok = lu.rank() == ni && Gxx[k].cwiseAbs().maxCoeff() > 0;
       if (ok) {
-        H = Gyx[k] * lu.inverse();
+        H = Gyx[k] * lu.inverse();  // the explained power below is H Gxy = Gyx Gxx^-1 Gxy
         for (Eigen::Index b = 0; b < no; ++b) {
-          const double explained = (Gyx[k].row(b) * lu.inverse() * Gyx[k].row(b).adjoint())(0, 0).real();
+          const double explained = (H.row(b) * Gyx[k].row(b).adjoint())(0, 0).real();
           coh[b] = Gyy(k, b) > 0 ? std::min(1.0, explained / Gyy(k, b)) : 0.0;
         }
         if (o.estimator == FrfOptions::Estimator::kH2)
