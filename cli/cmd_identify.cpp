@@ -44,32 +44,6 @@ std::vector<MeasuredDof> labels(const std::vector<std::string>& l, const char* w
   return out;
 }
 
-// Merges FRF sets with the same outputs and frequency grid: their inputs side by side.
-FrfData merge_frfs(std::vector<FrfData> sets) {
-  FrfData out = std::move(sets[0]);
-  for (std::size_t k = 1; k < sets.size(); ++k) {
-    const FrfData& s = sets[k];
-    if (s.frequency_hz.size() != out.frequency_hz.size() || !s.frequency_hz.isApprox(out.frequency_hz))
-      throw InputError(s.source + ": its frequency lines differ from " + out.source + "'s; FRFs identified together must share them");
-    if (s.outputs.size() != out.outputs.size()) throw InputError(s.source + ": its outputs differ from " + out.source + "'s");
-    for (std::size_t o = 0; o < s.outputs.size(); ++o)
-      if (!(s.outputs[o].dof == out.outputs[o].dof)) throw InputError(s.source + ": its outputs differ from " + out.source + "'s");
-    Eigen::MatrixXcd H(out.H.rows(), out.H.cols() + s.H.cols());
-    H << out.H, s.H;
-    out.H = H;
-    out.inputs.insert(out.inputs.end(), s.inputs.begin(), s.inputs.end());
-    if (out.coherence.size() && s.coherence.size()) {
-      Eigen::MatrixXd C(out.coherence.rows(), out.coherence.cols() + s.coherence.cols());
-      C << out.coherence, s.coherence;
-      out.coherence = C;
-    } else {
-      out.coherence.resize(0, 0);
-    }
-  }
-  out.validate("identify");
-  return out;
-}
-
 std::string describe_mode(const IdentificationSummary& s, std::size_t k) {
   const IdentifiedMode& m = s.modes[k];
   if (m.mpc < 0.5) return fmt::format("complex shape (MPC {:.2f}): not a normal mode; noise or a mathematical pole", m.mpc);

@@ -33,6 +33,7 @@ void register_commands(CLI::App& app, GlobalOptions& g) {
   register_update(app, g);
   register_identify(app, g);
   register_info(app, g);
+  register_discover(app, g);
 }
 
 }  // namespace dynid::cli

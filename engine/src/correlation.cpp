@@ -40,7 +40,10 @@ Pairing pair_modes(const Eigen::MatrixXd& mac, const Eigen::VectorXd& fa, const 
     for (int j = 0; j < nb; ++j) {
       if (!(mac(i, j) >= min_mac)) continue;
       const double df = freq && fa[i] > 0 ? std::min(1.0, std::abs(fb[j] - fa[i]) / fa[i]) : 0.0;
-      c.push_back({i, j, mac(i, j) - 0.1 * df});
+      // A partner more than a factor 2 away in frequency is a spatial alias (few sensors: a high mode can look
+      // like a low one at the measured DOFs), never preferred to a nearer one of similar MAC.
+      const double lr = freq && fa[i] > 0 && fb[j] > 0 ? std::abs(std::log(fb[j] / fa[i])) : 0.0;
+      c.push_back({i, j, mac(i, j) - 0.1 * df - (lr > std::log(2.0) ? std::min(0.9, 0.2 * lr) : 0.0)});
     }
   std::stable_sort(c.begin(), c.end(), [](const Cand& x, const Cand& y) { return x.score > y.score; });
   std::vector<char> ua(na, 0), ub(nb, 0);

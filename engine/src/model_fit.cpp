@@ -75,7 +75,8 @@ class Evaluator {
     const Model& model = pm.model();
     const int n = model.num_dofs();
     bool springs = false;
-    for (int p = 0; p < pm.num_parameters(); ++p) springs = springs || pm.parameter(p).kind == ParameterKind::kSpring;
+    for (int p = 0; p < pm.num_parameters(); ++p)  // springs (and custom terms) may tie a free-free model down
+      springs = springs || pm.parameter(p).kind == ParameterKind::kSpring || pm.parameter(p).kind == ParameterKind::kCustom;
     EigenOptions& eo = solver_.options();
     if (model.free_free() && !springs) eo.rigid_body_basis = model.free_rigid_body_modes();
     if (model.free_free() && springs) eo.allow_singular_stiffness = true;
@@ -207,11 +208,18 @@ class Evaluator {
       ev_.pair[q.a] = ev_.elastic[q.b];
       used[q.b] = 1;
     }
-    for (int k = 0; k < p; ++k) {  // unpaired: best remaining MAC, flagged
+    // Unpaired (no MAC >= min_mac left): the remaining mode with the best MAC less a frequency-distance penalty
+    // |ln(f_model / f_measured)| (at most 1.5), flagged. MAC alone would reach for any mode of the complete
+    // basis, however far in frequency, whose shape happens to correlate a little.
+    auto forced_score = [&](int k, std::size_t j) {
+      const double r = std::abs(std::log(std::max(fe[static_cast<Eigen::Index>(j)], 1e-300) / meas_.frequencies_hz[k]));
+      return mac(k, static_cast<Eigen::Index>(j)) - std::min(1.5, r);
+    };
+    for (int k = 0; k < p; ++k) {
       if (ev_.pair[k] >= 0) continue;
       int best = -1;
       for (std::size_t j = 0; j < ev_.elastic.size(); ++j)
-        if (!used[j] && (best < 0 || mac(k, static_cast<Eigen::Index>(j)) > mac(k, best))) best = static_cast<int>(j);
+        if (!used[j] && (best < 0 || forced_score(k, j) > forced_score(k, static_cast<std::size_t>(best)))) best = static_cast<int>(j);
       if (best < 0) {
         ev_.error = "measured mode " + std::to_string(k + 1) + " has no model mode left to pair with";
         return;

@@ -17,6 +17,7 @@ std::string_view parameter_kind_name(ParameterKind k) {
     case ParameterKind::kInertia: return "I";
     case ParameterKind::kPointMass: return "mass";
     case ParameterKind::kSpring: return "spring";
+    case ParameterKind::kCustom: return "custom";
   }
   return "?";
 }
@@ -49,7 +50,9 @@ int ParametricModel::add(const Parameter& p) {
   if (built_) throw InputError("ParametricModel: parameters must be added before the model is evaluated");
   const std::string who = "parameter '" + p.name + "'";
   const bool additive = p.kind == ParameterKind::kPointMass || p.kind == ParameterKind::kSpring;
-  if (additive) {
+  if (p.kind == ParameterKind::kCustom) {
+    // acts through custom terms only
+  } else if (additive) {
     if (p.node < 0 || p.node >= static_cast<int>(model_.nodes().size())) throw InputError(who + ": node does not exist");
     if (p.dofs == 0) throw InputError(who + ": no DOF types given");
     for (int t = 0; t < kNumDofTypes; ++t)
@@ -66,12 +69,32 @@ int ParametricModel::add(const Parameter& p) {
         throw InputError(who + ": " + eid + " is a spring; only a stiffness factor (E) acts on it");
       if (t == ElementType::PointMass && p.kind != ParameterKind::kMass)
         throw InputError(who + ": " + eid + " is a point mass; only a mass factor (rho) acts on it");
+      const int sec = model_.elements()[e].section;
+      if ((p.kind == ParameterKind::kArea || p.kind == ParameterKind::kInertia) && sec >= 0 &&
+          model_.sections()[sec].shear_factor > 0)
+        throw InputError(who + ": " + eid + " has shear deformation, whose stiffness is not linear in A or I; use E or rho");
     }
   }
   if (!(p.lower <= p.nominal && p.nominal <= p.upper))
     throw InputError(who + ": nominal value " + std::to_string(p.nominal) + " outside its bounds");
   params_.push_back(p);
   return static_cast<int>(params_.size()) - 1;
+}
+
+void ParametricModel::add_term(CustomTerm t) {
+  if (built_) throw InputError("ParametricModel: terms must be added before the model is evaluated");
+  if (!t.eval) throw InputError("ParametricModel: custom term without an evaluation function");
+  for (int p : t.params)
+    if (p < 0 || p >= num_parameters()) throw InputError("ParametricModel: custom term on parameter " + std::to_string(p) + ", which does not exist");
+  for (int d : t.dofs)
+    if (d < -1 || d >= model_.num_dofs()) throw InputError("ParametricModel: custom term on equation " + std::to_string(d) + ", which does not exist");
+  custom_.push_back({std::move(t), {}});
+}
+
+Eigen::VectorXd ParametricModel::sub(const Custom& c, const Eigen::VectorXd& theta) const {
+  Eigen::VectorXd v(static_cast<Eigen::Index>(c.term.params.size()));
+  for (std::size_t k = 0; k < c.term.params.size(); ++k) v[static_cast<Eigen::Index>(k)] = theta[c.term.params[k]];
+  return v;
 }
 
 Eigen::VectorXd ParametricModel::nominal() const {
@@ -159,6 +182,11 @@ void ParametricModel::build() const {
     t.additive = true;
     terms_.push_back(std::move(t));
   }
+  custom_of_param_.assign(params_.size(), {});
+  for (std::size_t k = 0; k < custom_.size(); ++k) {
+    custom_[k].pos = positions(custom_[k].term.dofs);
+    for (int p : custom_[k].term.params) custom_of_param_[p].push_back(static_cast<int>(k));
+  }
   terms_of_param_.assign(params_.size(), {});
   for (std::size_t k = 0; k < terms_.size(); ++k)
     for (int p : terms_[k].params) terms_of_param_[p].push_back(static_cast<int>(k));
@@ -204,6 +232,33 @@ void ParametricModel::matrices(const Eigen::VectorXd& theta, SparseMatrix* K, Sp
         if (q >= 0) v[q] += s * t.A(a, b);
       }
   }
+  Eigen::MatrixXd dK, dM;
+  for (const Custom& c : custom_) {
+    dK.resize(0, 0);
+    dM.resize(0, 0);
+    c.term.eval(sub(c, theta), K ? &dK : nullptr, M ? &dM : nullptr, nullptr, nullptr);
+    const int nd = static_cast<int>(c.term.dofs.size());
+    for (auto [target, A] : {std::pair{K, &dK}, std::pair{M, &dM}}) {
+      if (!target || A->size() == 0) continue;
+      double* v = target->valuePtr();
+      for (int a = 0; a < nd; ++a)
+        for (int b = 0; b < nd; ++b) {
+          const int q = c.pos[static_cast<std::size_t>(a) * nd + b];
+          if (q >= 0) v[q] += (*A)(a, b);
+        }
+    }
+  }
+}
+
+void ParametricModel::custom_derivative(int k, int p, const Eigen::VectorXd& theta, Eigen::MatrixXd* dK,
+                                        Eigen::MatrixXd* dM) const {
+  const Custom& c = custom_[k];
+  std::vector<Eigen::MatrixXd> dKd, dMd;
+  c.term.eval(sub(c, theta), nullptr, nullptr, &dKd, &dMd);
+  const auto j = static_cast<std::size_t>(std::find(c.term.params.begin(), c.term.params.end(), p) - c.term.params.begin());
+  const Eigen::Index nd = static_cast<Eigen::Index>(c.term.dofs.size());
+  *dK = j < dKd.size() && dKd[j].size() ? dKd[j] : Eigen::MatrixXd::Zero(nd, nd);
+  *dM = j < dMd.size() && dMd[j].size() ? dMd[j] : Eigen::MatrixXd::Zero(nd, nd);
 }
 
 Eigen::MatrixXd ParametricModel::eigenvalue_sensitivities(const Eigen::VectorXd& theta, const Eigen::VectorXd& lambda,
@@ -223,6 +278,19 @@ Eigen::MatrixXd ParametricModel::eigenvalue_sensitivities(const Eigen::VectorXd&
           if (t.dofs[a] >= 0) pe[a] = Phi(t.dofs[a], i);
         const double q = pe.dot(t.A * pe) * ds;
         S(i, p) += t.mass ? -lambda[i] * q : q;
+      }
+    }
+  Eigen::MatrixXd dK, dM;
+  for (int p = 0; p < num_parameters(); ++p)
+    for (int k : custom_of_param_[p]) {
+      custom_derivative(k, p, theta, &dK, &dM);
+      const std::vector<int>& dofs = custom_[k].term.dofs;
+      const int nd = static_cast<int>(dofs.size());
+      for (Eigen::Index i = 0; i < m; ++i) {
+        pe.setZero(nd);
+        for (int a = 0; a < nd; ++a)
+          if (dofs[a] >= 0) pe[a] = Phi(dofs[a], i);
+        S(i, p) += pe.dot((dK - lambda[i] * dM) * pe);
       }
     }
   return S;
@@ -248,6 +316,22 @@ void ParametricModel::derivative_products(int p, const Eigen::VectorXd& theta, c
       out->dof.push_back(t.dofs[a]);
       out->dKv.push_back(t.mass ? 0.0 : y[a]);
       out->dMv.push_back(t.mass ? y[a] : 0.0);
+    }
+  }
+  Eigen::MatrixXd dK, dM;
+  for (int k : custom_of_param_[p]) {
+    custom_derivative(k, p, theta, &dK, &dM);
+    const std::vector<int>& dofs = custom_[k].term.dofs;
+    const int nd = static_cast<int>(dofs.size());
+    ve.setZero(nd);
+    for (int a = 0; a < nd; ++a)
+      if (dofs[a] >= 0) ve[a] = v[dofs[a]];
+    const Eigen::VectorXd yk = dK * ve, ym = dM * ve;
+    for (int a = 0; a < nd; ++a) {
+      if (dofs[a] < 0) continue;
+      out->dof.push_back(dofs[a]);
+      out->dKv.push_back(yk[a]);
+      out->dMv.push_back(ym[a]);
     }
   }
 }

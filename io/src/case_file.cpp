@@ -70,6 +70,32 @@ std::string resolve(const std::string& dir, const std::string& file) {
   return p.is_absolute() ? file : (fs::path(dir) / p).lexically_normal().string();
 }
 
+// model: {include: other.yaml} takes the model section of another case file (path relative to this one).
+YAML::Node model_node(const YAML::Node& root, YamlCtx* ctx, std::string* dir, int depth) {
+  YAML::Node m = root["model"];
+  if (!m.IsMap() || !m["include"]) return m;
+  if (m.size() != 1) ctx->fail(m, "model: include cannot be combined with other model keys");
+  if (depth > 8) ctx->fail(m, "model: include nested too deep (a cycle?)");
+  const std::string file = resolve(*dir, ctx->string(m["include"], "model include"));
+  std::error_code ec;
+  const std::string path = resolve_case_path(file);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) ctx->fail(m["include"], "model include: cannot open '" + file + "'");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  YAML::Node inc;
+  try {
+    inc = YAML::Load(ss.str());
+  } catch (const YAML::ParserException& e) {
+    throw InputError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+                     ": malformed case file: " + e.msg);
+  }
+  if (!inc.IsMap() || !inc["model"]) ctx->fail(m["include"], "model include: '" + path + "' has no model: section");
+  ctx->file = path;
+  *dir = fs::path(path).parent_path().string();
+  return model_node(inc, ctx, dir, depth + 1);
+}
+
 }  // namespace internal
 
 using internal::parse_dof_selection;
@@ -190,32 +216,6 @@ DetectSpec parse_detect(const YAML::Node& n, const YamlCtx& ctx, const Model& mo
   return d;
 }
 
-// model: {include: other.yaml} takes the model section of another case file (path relative to this one).
-YAML::Node model_node(const YAML::Node& root, YamlCtx* ctx, std::string* dir, int depth) {
-  YAML::Node m = root["model"];
-  if (!m.IsMap() || !m["include"]) return m;
-  if (m.size() != 1) ctx->fail(m, "model: include cannot be combined with other model keys");
-  if (depth > 8) ctx->fail(m, "model: include nested too deep (a cycle?)");
-  const std::string file = resolve(*dir, ctx->string(m["include"], "model include"));
-  std::error_code ec;
-  const std::string path = resolve_case_path(file);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) ctx->fail(m["include"], "model include: cannot open '" + file + "'");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  YAML::Node inc;
-  try {
-    inc = YAML::Load(ss.str());
-  } catch (const YAML::ParserException& e) {
-    throw InputError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
-                     ": malformed case file: " + e.msg);
-  }
-  if (!inc.IsMap() || !inc["model"]) ctx->fail(m["include"], "model include: '" + path + "' has no model: section");
-  ctx->file = path;
-  *dir = fs::path(path).parent_path().string();
-  return model_node(inc, ctx, dir, depth + 1);
-}
-
 }  // namespace
 
 std::string resolve_case_path(const std::string& path) {
@@ -242,7 +242,7 @@ Case parse_case(const std::string& text, const std::string& name, const std::str
   }
   if (!root || root.IsNull()) throw InputError(name + ": the case file is empty");
   ctx.require_map(root, "case file");
-  ctx.only_keys(root, "the case file", {"name", "description", "model", "analysis", "detect", "update", "test"});
+  ctx.only_keys(root, "the case file", {"name", "description", "model", "analysis", "detect", "update", "test", "discover"});
   Case c;
   c.path = name;
   c.dir = dir;
@@ -252,13 +252,14 @@ Case parse_case(const std::string& text, const std::string& name, const std::str
   {
     YamlCtx mctx = ctx;
     std::string mdir = dir;
-    const YAML::Node m = model_node(root, &mctx, &mdir, 0);
+    const YAML::Node m = internal::model_node(root, &mctx, &mdir, 0);
     c.model = internal::parse_model(m, mctx, mdir, &c.notes);
   }
   c.analysis = parse_analysis(root["analysis"], ctx);
   if (root["detect"]) c.detect = parse_detect(root["detect"], ctx, c.model, dir);
   if (root["update"]) c.update = internal::parse_update(root["update"], ctx, c.model, dir);
   if (root["test"]) c.test = internal::parse_test(root["test"], ctx, c.model, dir);
+  if (root["discover"]) c.discover = internal::parse_discover(root["discover"], ctx, c.model, dir);
   return c;
 }
 

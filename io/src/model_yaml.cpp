@@ -61,7 +61,7 @@ struct Parser {
       const YAML::Node& v = kv.second;
       const std::string w = "section '" + name + "'";
       ctx.require_map(v, w);
-      ctx.only_keys(v, w, {"A", "I", "Iz", "Iy", "J", "rectangle", "circle"});
+      ctx.only_keys(v, w, {"A", "I", "Iz", "Iy", "J", "rectangle", "circle", "shear_factor"});
       Section s;
       s.name = name;
       if (v["rectangle"]) {
@@ -85,6 +85,7 @@ struct Parser {
       if (v["Iz"]) s.Iz = ctx.number(v["Iz"], w + " Iz");
       if (v["Iy"]) s.Iy = ctx.number(v["Iy"], w + " Iy");
       if (v["J"]) s.J = ctx.number(v["J"], w + " J");
+      if (v["shear_factor"]) s.shear_factor = ctx.number(v["shear_factor"], w + " shear_factor");
       if (v["I"] && v["Iz"]) fail(v, w + ": give either I or Iz, not both");
       if (!(v["A"] || v["rectangle"] || v["circle"])) fail(v, w + ": area A is missing");
       sections[name] = model.add_section(s);
@@ -177,7 +178,7 @@ struct Parser {
         el.material = material_of(YAML::Node(YAML::NodeType::Undefined), w);
         el.section = section_of(YAML::Node(YAML::NodeType::Undefined), w);
       } else if (e.IsMap()) {
-        ctx.only_keys(e, "element", {"id", "nodes", "type", "material", "section", "orientation", "group"});
+        ctx.only_keys(e, "element", {"id", "nodes", "type", "material", "section", "orientation", "group", "axial_force"});
         el.id = ctx.integer(e["id"], "element id");
         w = "element " + std::to_string(el.id);
         if (e["type"]) {
@@ -192,6 +193,7 @@ struct Parser {
         el.section = section_of(e["section"], w);
         if (e["orientation"]) el.orientation = orientation_of(e["orientation"], w);
         if (e["group"]) el.group = ctx.string(e["group"], w + " group");
+        if (e["axial_force"]) el.axial_force = ctx.number(e["axial_force"], w + " axial_force");
       } else {
         fail(e, "element: expected [id, node_a, node_b] or a mapping");
       }

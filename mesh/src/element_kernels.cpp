@@ -10,13 +10,8 @@ namespace {
 
 // Bending stiffness block for (w1, t1, w2, t2) with the convention w' = +t (x-y plane).
 // For the x-z plane (w' = -t) the sign of the off-diagonal L terms flips: pass s = -1.
-void bending_k(double EI, double L, double s, Eigen::Matrix4d* k) {
-  const double c = EI / (L * L * L), L2 = L * L;
-  *k << 12, 6 * L * s, -12, 6 * L * s,    //
-      6 * L * s, 4 * L2, -6 * L * s, 2 * L2,  //
-      -12, -6 * L * s, 12, -6 * L * s,    //
-      6 * L * s, 2 * L2, -6 * L * s, 4 * L2;
-  *k *= c;
+void bending_k(double EI, double L, double phi, double s, Eigen::Matrix4d* k) {
+  *k = beam_bending_k<double>(EI, L, phi, s);
 }
 
 void bending_m(double rhoA, double L, double s, Eigen::Matrix4d* m) {
@@ -28,7 +23,8 @@ void bending_m(double rhoA, double L, double s, Eigen::Matrix4d* m) {
   *m *= c;
 }
 
-// Rayleigh rotary inertia of a cubic-Hermite beam.
+// Rayleigh rotary inertia of a cubic-Hermite beam; with rhoI -> P it is also the consistent geometric stiffness
+// of an axial force P (both are int N'^T N' dx).
 void rotary_m(double rhoI, double L, double s, Eigen::Matrix4d* m) {
   const double c = rhoI / (30.0 * L), L2 = L * L;
   *m << 36, 3 * L * s, -36, 3 * L * s,  //
@@ -64,7 +60,7 @@ void scatter_bar_mass(double m, int i, int j, bool lumped, Eigen::MatrixXd* out)
 }
 
 void zero_all(int n, MemberLocal* o) {
-  for (Eigen::MatrixXd* m : {&o->Ka, &o->Kb, &o->Kt, &o->Mt, &o->Mr}) m->setZero(n, n);
+  for (Eigen::MatrixXd* m : {&o->Ka, &o->Kb, &o->Kt, &o->Kg, &o->Mt, &o->Mr}) m->setZero(n, n);
 }
 
 }  // namespace
@@ -75,8 +71,12 @@ void frame2d_local(const MemberProps& p, MemberLocal* o) {
   scatter_bar(p.EA / L, 0, 3, &o->Ka);
   const std::array<int, 4> bi{{1, 2, 4, 5}};
   Eigen::Matrix4d b;
-  bending_k(p.EIz, L, 1.0, &b);
+  bending_k(p.EIz, L, p.phiz, 1.0, &b);
   scatter4(b, bi, &o->Kb);
+  if (p.P != 0.0) {
+    rotary_m(p.P, L, 1.0, &b);
+    scatter4(b, bi, &o->Kg);
+  }
   const double m = p.rhoA * L;
   scatter_bar_mass(m, 0, 3, p.lumped, &o->Mt);
   if (p.lumped) {
@@ -99,10 +99,16 @@ void frame3d_local(const MemberProps& p, MemberLocal* o) {
   scatter_bar(p.GJ / L, 3, 9, &o->Kt);
   const std::array<int, 4> xy{{1, 5, 7, 11}}, xz{{2, 4, 8, 10}};
   Eigen::Matrix4d b;
-  bending_k(p.EIz, L, 1.0, &b);
+  bending_k(p.EIz, L, p.phiz, 1.0, &b);
   scatter4(b, xy, &o->Kb);
-  bending_k(p.EIy, L, -1.0, &b);
+  bending_k(p.EIy, L, p.phiy, -1.0, &b);
   scatter4(b, xz, &o->Kb);
+  if (p.P != 0.0) {
+    rotary_m(p.P, L, 1.0, &b);
+    scatter4(b, xy, &o->Kg);
+    rotary_m(p.P, L, -1.0, &b);
+    scatter4(b, xz, &o->Kg);
+  }
   const double m = p.rhoA * L;
   scatter_bar_mass(m, 0, 6, p.lumped, &o->Mt);
   // Torsional inertia (polar moment Iy + Iz) is always included: without it twisting DOFs would be massless.

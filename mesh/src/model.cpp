@@ -96,7 +96,7 @@ bool parse_element_type(std::string_view name, ElementType* out) {
   return false;
 }
 
-Eigen::MatrixXd ElementParts::K() const { return K_axial + K_bending + K_torsion + K_discrete; }
+Eigen::MatrixXd ElementParts::K() const { return K_axial + K_bending + K_torsion + K_discrete + K_geometric; }
 Eigen::MatrixXd ElementParts::M() const { return M_translational + M_rotary + M_discrete; }
 
 int Model::add_node(int id, const Eigen::Vector3d& x) {
@@ -206,6 +206,11 @@ void Model::finalize() {
       if (!(std::isfinite(m.rho) && m.rho >= 0)) throw InputError(mat + " has density rho = " + fmt_num(m.rho) + "; it must be >= 0");
       if (!finite_positive(s.A)) throw InputError(sec + " has area A = " + fmt_num(s.A) + "; it must be > 0");
       if (!finite_positive(s.Iz)) throw InputError(sec + " has second moment Iz = " + fmt_num(s.Iz) + "; it must be > 0");
+      if (!(std::isfinite(s.shear_factor) && s.shear_factor >= 0))
+        throw InputError(sec + " has shear factor " + fmt_num(s.shear_factor) + "; it must be >= 0 (0 = no shear deformation)");
+      if (s.shear_factor > 0 && !(m.G > 0 || (std::isfinite(m.nu) && m.nu > -1 && m.nu < 0.5)))
+        throw InputError(mat + ": shear deformation (section shear_factor) needs a shear modulus G or a Poisson's ratio in (-1, 0.5)");
+      if (!std::isfinite(e.axial_force)) throw InputError(who + ": axial_force must be finite");
       if (e.type == ElementType::Frame3D) {
         if (!finite_positive(s.Iy)) throw InputError(sec + " has second moment Iy = " + fmt_num(s.Iy) + "; it must be > 0");
         if (!(std::isfinite(s.J) && s.J >= 0)) throw InputError(sec + " has torsion constant J = " + fmt_num(s.J) + "; it must be >= 0");
@@ -356,7 +361,7 @@ std::vector<std::pair<int, Dof>> Model::element_dof_types(int e) const {
   return out;
 }
 
-void Model::member_local(int e, internal::MemberLocal* loc, Eigen::MatrixXd* T) const {
+void Model::member_local(int e, internal::MemberLocal* loc, Eigen::MatrixXd* T, const double* axial_force) const {
   const Element& el = elements_[e];
   const Material& mat = materials_[el.material];
   const Section& sec = sections_[el.section];
@@ -375,6 +380,12 @@ void Model::member_local(int e, internal::MemberLocal* loc, Eigen::MatrixXd* T) 
   mp.rhoIy = rho * sec.Iy * f.I;
   mp.lumped = mass_type_ == MassType::Lumped;
   mp.rotary = rotary_inertia_;
+  if (sec.shear_factor > 0) {
+    const double GAs = sec.shear_factor * mat.shear_modulus() * f.E * A * mp.L * mp.L;
+    mp.phiz = 12.0 * mp.EIz / GAs;
+    mp.phiy = 12.0 * mp.EIy / GAs;
+  }
+  mp.P = axial_force ? *axial_force : el.axial_force;
   if (el.type == ElementType::Frame3D) {
     internal::frame3d_local(mp, loc);
     Eigen::Matrix3d R;
@@ -416,8 +427,8 @@ ElementParts Model::element_parts(int e) const {
   ElementParts p;
   if (el.type == ElementType::PointMass || el.type == ElementType::Spring) {
     const int n = static_cast<int>(element_dof_types(e).size());
-    for (Eigen::MatrixXd* m : {&p.K_axial, &p.K_bending, &p.K_torsion, &p.K_discrete, &p.M_translational,
-                               &p.M_rotary, &p.M_discrete})
+    for (Eigen::MatrixXd* m : {&p.K_axial, &p.K_bending, &p.K_torsion, &p.K_discrete, &p.K_geometric,
+                               &p.M_translational, &p.M_rotary, &p.M_discrete})
       m->setZero(n, n);
     if (el.type == ElementType::PointMass) {
       int i = 0;
@@ -445,12 +456,25 @@ ElementParts Model::element_parts(int e) const {
   p.K_axial = tr(loc.Ka);
   p.K_bending = tr(loc.Kb);
   p.K_torsion = tr(loc.Kt);
+  p.K_geometric = tr(loc.Kg);
   p.M_translational = tr(loc.Mt);
   p.M_rotary = tr(loc.Mr);
   const Eigen::Index n = p.K_axial.rows();
   p.K_discrete.setZero(n, n);
   p.M_discrete.setZero(n, n);
   return p;
+}
+
+Eigen::MatrixXd Model::unit_geometric_stiffness(int e) const {
+  require_finalized("unit_geometric_stiffness");
+  const ElementType t = elements_[e].type;
+  if (t == ElementType::PointMass || t == ElementType::Spring)
+    throw InputError("element " + std::to_string(elements_[e].id) + ": only beams and frames have a geometric stiffness");
+  internal::MemberLocal loc;
+  Eigen::MatrixXd T;
+  const double unit = 1.0;
+  member_local(e, &loc, &T, &unit);
+  return T.transpose() * loc.Kg * T;
 }
 
 void Model::element_matrices(int e, Eigen::MatrixXd* K, Eigen::MatrixXd* M) const {
@@ -460,7 +484,7 @@ void Model::element_matrices(int e, Eigen::MatrixXd* K, Eigen::MatrixXd* M) cons
     Eigen::MatrixXd T;
     member_local(e, &loc, &T);
     const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
-    if (K) rotate_blocks(loc.Ka + loc.Kb + loc.Kt, R, K);
+    if (K) rotate_blocks(loc.Ka + loc.Kb + loc.Kt + loc.Kg, R, K);
     if (M) rotate_blocks(loc.Mt + loc.Mr, R, M);
     return;
   }

@@ -14,13 +14,32 @@ struct MemberProps {
   double L = 0;
   double EA = 0, EIy = 0, EIz = 0, GJ = 0;
   double rhoA = 0, rhoIy = 0, rhoIz = 0;
+  /// Shear deformation (Timoshenko stiffness): phi = 12 E I / (kappa G A L^2) per bending plane; 0 = Euler-Bernoulli.
+  double phiy = 0, phiz = 0;
+  /// Axial force (tension > 0) for the geometric stiffness Kg.
+  double P = 0;
   bool lumped = false;
   bool rotary = false;
 };
 
 struct MemberLocal {
-  Eigen::MatrixXd Ka, Kb, Kt, Mt, Mr;
+  Eigen::MatrixXd Ka, Kb, Kt, Kg, Mt, Mr;
 };
+
+/// Bending stiffness of a two-node beam on (w1, t1, w2, t2) with shear deformation phi = 12 EI / (kappa G A L^2)
+/// (Przemieniecki; phi = 0 is Euler-Bernoulli). s = +1 for w' = +t (x-y plane), -1 for the x-z plane. The
+/// scalar type may be complex (complex-step derivatives).
+template <class S>
+Eigen::Matrix<S, 4, 4> beam_bending_k(double EI, double L, S phi, double s) {
+  const S c = EI / (L * L * L) / (1.0 + phi);
+  const double L2 = L * L;
+  Eigen::Matrix<S, 4, 4> k;
+  k << S(12), S(6 * L * s), S(-12), S(6 * L * s),                           //
+      S(6 * L * s), (4.0 + phi) * L2, S(-6 * L * s), (2.0 - phi) * L2,      //
+      S(-12), S(-6 * L * s), S(12), S(-6 * L * s),                          //
+      S(6 * L * s), (2.0 - phi) * L2, S(-6 * L * s), (4.0 + phi) * L2;
+  return c * k;
+}
 
 void frame2d_local(const MemberProps& p, MemberLocal* out);
 void frame3d_local(const MemberProps& p, MemberLocal* out);

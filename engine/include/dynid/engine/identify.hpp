@@ -85,6 +85,16 @@ IdentificationSummary identify_lscf(const FrfData& frf, const IdentificationOpti
 /// the correlation estimate, each record's mean removed).
 IdentificationSummary identify_ssi(const Recording& recording, const IdentificationOptions& options);
 
+/// FRF sets with the same outputs and frequency lines merged: their inputs side by side. Throws InputError if
+/// they do not match.
+FrfData merge_frfs(std::vector<FrfData> sets);
+
+/// Recordings identified as a whole: "lscf" on H1 FRFs (recordings with force channels; a roving hammer gives one
+/// recording per hit location) or "ssi" (output-only; records of all recordings concatenated); "" picks by the
+/// data.
+IdentificationSummary identify_recordings(std::vector<Recording> recordings, const std::string& method,
+                                          const IdentificationOptions& options);
+
 /// Peaks of a magnitude spectrum (e.g. a dB spectrum without phase): local maxima in [lo, hi] standing at
 /// least `min_prominence_db` above the higher of the two minima that separate them from higher peaks (or the
 /// band edges), located by parabolic interpolation of the dB values around the maximum line. Strongest first.

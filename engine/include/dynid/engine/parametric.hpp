@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -21,7 +22,8 @@ namespace dynid {
 ///   kPointMass  kg on the translations `dofs` of `node`;  kSpring  N/m (or N m/rad) grounded on `dofs` of `node`.
 /// Parts touched by several factors scale by their product (E and I on one element act as E*I), so K(theta)
 /// is always exact.
-enum class ParameterKind { kStiffness, kMass, kArea, kInertia, kPointMass, kSpring };
+///   kCustom     acts only through CustomTerms (any smooth dependence; model augmentations of discovery).
+enum class ParameterKind { kStiffness, kMass, kArea, kInertia, kPointMass, kSpring, kCustom };
 std::string_view parameter_kind_name(ParameterKind k);  // "E", "rho", "A", "I", "mass", "spring"
 
 struct Parameter {
@@ -36,6 +38,20 @@ struct Parameter {
   double scale = 1.0;         ///< typical magnitude (prior std for regularisation; 1 for factors)
 };
 
+/// A block of K and M that depends on parameters in any smooth way (the model augmentations of discovery: a
+/// semi-rigid joint, shear deformation, a preload, ...). It lives on equations `dofs` (-1 = restrained: those
+/// rows and columns are skipped), whose pairs must lie in the model's sparsity pattern (an element's DOFs, or
+/// one node's DOFs), and is added to K(theta), M(theta) at every theta.
+struct CustomTerm {
+  std::vector<int> dofs;
+  std::vector<int> params;  ///< the parameters it depends on (ParametricModel indices)
+  /// Evaluates the block at `theta` (values of `params`, in order): dK and dM (left empty = zero) and, when dKd
+  /// and dMd are not null, their exact derivatives, one matrix per parameter (empty = zero).
+  std::function<void(const Eigen::VectorXd& theta, Eigen::MatrixXd* dK, Eigen::MatrixXd* dM,
+                     std::vector<Eigen::MatrixXd>* dKd, std::vector<Eigen::MatrixXd>* dMd)>
+      eval;
+};
+
 /// A copy of `model` with element property factors multiplied (simulated targets: e.g. element 4's rho x 1.2).
 Model apply_factors(const Model& model, const std::vector<std::pair<int, PropertyFactors>>& changes);
 
@@ -47,6 +63,9 @@ class ParametricModel {
   /// Adds a parameter (before the first matrices()/sensitivity call). Returns its index. Throws InputError for
   /// unknown elements or nodes, or DOFs the node does not have.
   int add(const Parameter& p);
+  /// Adds a custom term (before the first evaluation); its parameters must exist. Throws InputError otherwise.
+  void add_term(CustomTerm t);
+  int num_terms() const { return static_cast<int>(custom_.size()); }
   int num_parameters() const { return static_cast<int>(params_.size()); }
   const Parameter& parameter(int p) const { return params_[p]; }
   Eigen::VectorXd nominal() const;
@@ -92,6 +111,14 @@ class ParametricModel {
   mutable std::vector<Term> terms_;
   mutable Eigen::VectorXd Kfixed_, Mfixed_;           // nominal values minus the parameterised terms
   mutable std::vector<std::vector<int>> terms_of_param_;
+  struct Custom {
+    CustomTerm term;
+    std::vector<int> pos;  // CSC positions of the (a, b) pairs, row-major; -1 skipped
+  };
+  mutable std::vector<Custom> custom_;
+  mutable std::vector<std::vector<int>> custom_of_param_;
+  Eigen::VectorXd sub(const Custom& c, const Eigen::VectorXd& theta) const;
+  void custom_derivative(int k, int p, const Eigen::VectorXd& theta, Eigen::MatrixXd* dK, Eigen::MatrixXd* dM) const;
 };
 
 }  // namespace dynid

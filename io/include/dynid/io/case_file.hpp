@@ -3,11 +3,13 @@
 #pragma once
 
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "dynid/engine/detect.hpp"
+#include "dynid/engine/discovery.hpp"
 #include "dynid/engine/identify.hpp"
 #include "dynid/engine/virtual_test.hpp"
 #include "dynid/engine/model_fit.hpp"
@@ -65,6 +67,32 @@ struct TestSpec {
   IdentificationOptions identify;
 };
 
+/// What `discover:` asks for (docs/case-file.md): the measured data (modal data from a file, recordings to
+/// identify first, or - for concealed-data studies - a virtual test of a `truth` model the analysis never sees),
+/// the discovery options, and optionally what the answer should be (`expect`, for the test suite).
+struct DiscoverSpec {
+  std::string measured_file;               ///< UFF 55 or modal-data JSON
+  std::vector<std::string> recordings;     ///< UFF 58 / text recordings, identified first
+  std::string method;                      ///< identification method for recordings ("" = by the data)
+  IdentificationOptions identify;
+  std::shared_ptr<Model> truth;            ///< concealed-data study: the truth model
+  std::shared_ptr<TestSpec> truth_test;    ///< and its virtual test
+  int modes = 0;                           ///< first modes used (0 = all identified)
+  double min_mpc = 0.8;                    ///< identified modes below this MPC are left out (not normal modes)
+  DiscoveryOptions options;
+  int seeds = 1;                           ///< robustness study: repeat the truth test with this many seeds
+  struct Expect {
+    std::string kind;
+    std::vector<int> nodes, elements;      ///< the finding's site must contain these (either list may be empty)
+    std::string parameter;                 ///< physical value checked (name as reported)
+    double value = 0;
+    double tolerance = 0.10;               ///< relative
+    std::string verdict = "missing_physics";
+    std::vector<Expect> also;              ///< further effects (any order among the findings)
+  };
+  std::optional<Expect> expect;
+};
+
 struct Case {
   std::string path;         ///< the case file
   std::string dir;          ///< its folder (relative paths in the case resolve against it)
@@ -75,6 +103,7 @@ struct Case {
   std::optional<DetectSpec> detect;
   std::optional<UpdateSpec> update;
   std::optional<TestSpec> test;
+  std::optional<DiscoverSpec> discover;
 };
 
 /// Loads a case from a case file, or from a folder holding case.yaml / case.yml / case.json.

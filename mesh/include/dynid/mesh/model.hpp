@@ -52,6 +52,9 @@ struct Section {
   double Iy = 0;  // second moment about the local y axis (3D frames: bending in the local x-z plane)
   double Iz = 0;  // second moment about the local z axis (bending in the plane of 2D beams and frames)
   double J = 0;   // torsion constant (3D frames); 0 = Iy + Iz
+  /// Timoshenko shear coefficient kappa (5/6 for a rectangle): bending stiffness with shear deformation,
+  /// phi = 12 E I / (kappa G A L^2). 0 = Euler-Bernoulli (no shear deformation).
+  double shear_factor = 0;
   double torsion_constant() const { return J > 0 ? J : Iy + Iz; }
 };
 
@@ -73,16 +76,18 @@ struct Element {
   Eigen::Vector3d rotary_inertia = Eigen::Vector3d::Zero();  // PointMass: about global x, y, z
   DofMask spring_dofs = 0;                                   // Spring: DOF types it acts on
   double stiffness = 0;                                      // Spring: per DOF (N/m or N m/rad)
+  double axial_force = 0;  // beams and frames: axial force (tension > 0) -> geometric stiffness (preload)
   PropertyFactors factors;
   std::string group;  // optional group name (updating parameters may act per group)
 };
 
 /// Element matrices split into parts that are linear in one property each, in global coordinates:
 ///   K = K_axial (~ E A) + K_bending (~ E I) + K_torsion (~ G J) + K_discrete (springs)
+///       + K_geometric (~ axial force; independent of the property factors)
 ///   M = M_translational (~ rho A) + M_rotary (~ rho I, only with rotary inertia) + M_discrete (point masses)
 /// Each part already includes the element's current property factors.
 struct ElementParts {
-  Eigen::MatrixXd K_axial, K_bending, K_torsion, K_discrete;
+  Eigen::MatrixXd K_axial, K_bending, K_torsion, K_discrete, K_geometric;
   Eigen::MatrixXd M_translational, M_rotary, M_discrete;
   Eigen::MatrixXd K() const;
   Eigen::MatrixXd M() const;
@@ -142,6 +147,9 @@ class Model : public ElementSource {
   std::vector<std::pair<int, Dof>> element_dof_types(int e) const;
   /// The element's matrices split by property (see ElementParts).
   ElementParts element_parts(int e) const;
+  /// Beams and frames: the consistent geometric stiffness of a unit axial tension, in global coordinates on the
+  /// element's DOFs (int N'^T N' dx per bending plane). Scaled by rho I it is also the Rayleigh rotary inertia.
+  Eigen::MatrixXd unit_geometric_stiffness(int e) const;
 
   /// Geometric rigid-body motions restricted to the free DOFs: columns are unit translations along x, y, z and
   /// unit rotations about x, y, z through the centroid of the nodes; columns that vanish on the free DOFs
@@ -155,7 +163,7 @@ class Model : public ElementSource {
 
  private:
   void require_finalized(const char* what) const;
-  void member_local(int e, internal::MemberLocal* loc, Eigen::MatrixXd* T) const;
+  void member_local(int e, internal::MemberLocal* loc, Eigen::MatrixXd* T, const double* axial_force = nullptr) const;
   std::vector<Node> nodes_;
   std::vector<Material> materials_;
   std::vector<Section> sections_;

@@ -1,0 +1,140 @@
+// dynid discover: missing-physics discovery on a case's discover: section.
+#include <fmt/core.h>
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+
+#include "commands.hpp"
+#include "dynid/io/discover_io.hpp"
+#include "dynid/io/output.hpp"
+#include "dynid/mesh/error.hpp"
+#include "progress.hpp"
+
+namespace fs = std::filesystem;
+
+namespace dynid::cli {
+
+namespace {
+
+struct DiscoverArgs {
+  std::string case_path, json, plot;
+  int seeds = 0;  // 0 = the case's
+  bool force = false;
+  bool exact = false;  // diagnosis: the truth model's exact modes instead of the identified ones
+};
+
+void print_summary(const Case& c, const DiscoveryData& d, const DiscoverySummary& s) {
+  fmt::print("dynid discover: {} — {} measured modes at {} DOFs ({})\n", c.name, d.measured.num_modes(), d.measured.dofs.size(), d.source);
+  for (const std::string& n : d.notes) fmt::print("  note: {}\n", n);
+  fmt::print("  1. where:  {}\n", s.localization.words);
+  fmt::print("  2-3. candidates (BIC improvement over the model as given; > 10 is decisive):\n");
+  fmt::print("       {:>4}  {:<22} {:<28} {:>9} {:>9} {:>8}\n", "rank", "kind", "where", "evidence", "max df %", "MAC");
+  const int show = std::min<int>(12, static_cast<int>(s.candidates.size()));
+  for (int k = 0; k < show; ++k) {
+    const ScoredHypothesis& h = s.candidates[k];
+    std::string where = h.global ? "global" : "";
+    if (!h.global) {
+      for (int n : h.site.nodes) where += (where.empty() ? "n" : ",n") + std::to_string(n);
+      for (int e : h.site.elements) where += (where.empty() ? "e" : ",e") + std::to_string(e);
+    }
+    if (where.size() > 28) where = where.substr(0, 25) + "...";
+    fmt::print("       {:>4}  {:<22} {:<28} {:>9.1f} {:>9.3f} {:>8.5f}{}\n", k + 1, h.kind, where, h.delta_bic, h.max_freq_error_pct, h.mean_mac,
+               h.at_bound ? "  (at a bound)" : "");
+  }
+  const ScoredHypothesis& r = s.recalibration;
+  fmt::print("       {:>4}  {:<22} {:<28} {:>9.1f} {:>9.3f} {:>8.5f}\n", "-", "global_recalibration", "global (E, rho)", r.delta_bic,
+             r.max_freq_error_pct, r.mean_mac);
+  fmt::print("  4. verdict: {}\n     {}\n", s.verdict, s.explanation);
+  fmt::print("     fit: max frequency error {:.3f} % -> {:.3f} %, mean MAC {:.5f} -> {:.5f} ({} eigen-solves, {:.1f} s)\n",
+             s.before.max_freq_error_pct, s.after.max_freq_error_pct, s.before.mean_mac, s.after.mean_mac, s.eigen_solves, s.seconds);
+}
+
+int run_discover(const DiscoverArgs& a, const GlobalOptions& g) {
+  set_threads(g.threads);
+  const Case c = load_case(a.case_path);
+  if (!c.discover) throw InputError(c.path + ": the case has no discover: section (see docs/case-file.md)");
+  const DiscoverSpec& spec = *c.discover;
+  const int seeds = a.seeds > 0 ? a.seeds : spec.seeds;
+  if (seeds > 1 && !spec.truth) throw InputError("discover: --seeds needs a case with a truth: model (a concealed-data study)");
+  const std::string stem = (fs::path(c.dir) / c.name).string();
+  const std::string json = a.json.empty() ? c.name + "-discover.json" : a.json;
+  const std::string png = a.plot.empty() ? c.name + "-discover.png" : a.plot;
+  for (const std::string& p : {json, png})
+    if (!a.force && fs::exists(p)) throw InputError(p + ": file exists; pass --force to overwrite it");
+  (void)stem;
+  Progress progress(!g.quiet);
+  progress.update(spec.truth ? "virtual test of the truth model and identification" : "measured data", -1);
+  DiscoveryData d = discovery_data(c, 0);
+  if (a.exact) {
+    if (!spec.truth) throw InputError("discover: --exact needs a case with a truth: model");
+    // The truth's modes at the sensors that the identification found (paired by frequency within 5 %).
+    ModalData e = d.measured;
+    for (Eigen::Index k = 0; k < e.frequencies_hz.size(); ++k) {
+      Eigen::Index best = 0;
+      (d.truth_modes.frequencies_hz.array() - e.frequencies_hz[k]).abs().minCoeff(&best);
+      e.frequencies_hz[k] = d.truth_modes.frequencies_hz[best];
+      e.shapes.col(k) = d.truth_modes.shapes.col(best);
+    }
+    e.frequency_std_hz.resize(0);
+    e.source = "exact modes of the truth model";
+    d.measured = e;
+    d.source = e.source;
+  }
+  progress.update("discovery", -1);
+  const DiscoverySummary s = discover(c.model, d.measured, spec.options);
+  std::unique_ptr<ExpectCheck> check;
+  if (spec.expect) check = std::make_unique<ExpectCheck>(check_expectation(*spec.expect, s));
+  nlohmann::ordered_json j = discovery_json(c, d, s, check.get());
+
+  // Robustness: the same case over further noise seeds of the truth test.
+  if (seeds > 1) {
+    int named = check && check->ok() ? 1 : 0, consistent = s.verdict == "consistent";
+    std::vector<double> errs = {check ? check->parameter_error : NAN};
+    nlohmann::ordered_json runs = nlohmann::ordered_json::array();
+    runs.push_back({{"seed_offset", 0}, {"verdict", s.verdict}, {"first", s.findings.empty() ? "" : s.findings[0].kind}, {"ok", check && check->ok()}});
+    for (int k = 1; k < seeds; ++k) {
+      progress.update("robustness: seed " + std::to_string(k + 1) + " of " + std::to_string(seeds), -1);
+      const DiscoveryData dk = discovery_data(c, k);
+      const DiscoverySummary sk = discover(c.model, dk.measured, spec.options);
+      const bool ok = spec.expect && check_expectation(*spec.expect, sk).ok();
+      named += ok;
+      consistent += sk.verdict == "consistent";
+      if (spec.expect) errs.push_back(check_expectation(*spec.expect, sk).parameter_error);
+      runs.push_back({{"seed_offset", k}, {"verdict", sk.verdict}, {"first", sk.findings.empty() ? "" : sk.findings[0].kind}, {"ok", ok}});
+    }
+    double worst = 0;
+    for (double e : errs)
+      if (std::isfinite(e)) worst = std::max(worst, e);
+    j["robustness"] = {{"seeds", seeds}, {"as_expected", named}, {"rate", static_cast<double>(named) / seeds},
+                       {"consistent", consistent}, {"worst_parameter_error", worst}, {"runs", runs}};
+  }
+  progress.done();
+  write_file_atomic(json, j.dump(1) + "\n", a.force);
+  plot::save(discovery_figure(c, s), png, a.force);
+  if (!g.quiet) {
+    print_summary(c, d, s);
+    if (check) fmt::print("  expected: {}\n", check->words);
+    if (seeds > 1)
+      fmt::print("  robustness: {} of {} seeds as expected ({:.0f} %)\n", j["robustness"]["as_expected"].get<int>(), seeds,
+                 100.0 * j["robustness"]["rate"].get<double>());
+    fmt::print("  wrote {}, {}\n", json, png);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void register_discover(CLI::App& app, GlobalOptions& g) {
+  auto a = std::make_shared<DiscoverArgs>();
+  CLI::App* cmd = app.add_subcommand("discover", "Find what physics the model leaves out: locate the mismatch, fit candidate effects, report");
+  cmd->add_option("CASE", a->case_path, "Case file or folder with a discover: section")->required();
+  cmd->add_option("--json", a->json, "Results JSON (default: <case>-discover.json)");
+  cmd->add_option("--plot", a->plot, "Report figure, .png or .svg (default: <case>-discover.png)");
+  cmd->add_option("--seeds", a->seeds, "Robustness study: repeat the truth test over this many noise seeds")->check(CLI::Range(1, 1000));
+  cmd->add_flag("--force", a->force, "Overwrite existing output files");
+  cmd->add_flag("--exact", a->exact, "Diagnosis: use the truth model's exact modes (the ones identified) instead of the identified values");
+  cmd->callback([a, &g]() { g.exit_code = run_guarded("discover", [&] { return run_discover(*a, g); }); });
+}
+
+}  // namespace dynid::cli

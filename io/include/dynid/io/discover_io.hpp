@@ -1,0 +1,45 @@
+// dynid/io/discover_io.hpp -- the data a discover: case names, the results JSON and the report figure.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "dynid/engine/discovery.hpp"
+#include "dynid/engine/identify.hpp"
+#include "dynid/io/case_file.hpp"
+#include "dynid/io/plot.hpp"
+
+namespace dynid {
+
+/// The measured modes of a discover: case, and how they were obtained.
+struct DiscoveryData {
+  ModalData measured;
+  bool identified = false;                 ///< identified from recordings (virtual or real)
+  IdentificationSummary identification;
+  ModalData truth_modes;                   ///< virtual test: the truth model's modes (reporting only)
+  std::string source;
+  std::vector<std::string> notes;          ///< modes left out and why
+};
+
+/// Reads (or identifies, or simulates and identifies) the measured modes; `seed_offset` shifts the truth test's
+/// noise seed (robustness studies).
+DiscoveryData discovery_data(const Case& c, int seed_offset = 0);
+
+/// How a discovery compares with the case's `expect:`.
+struct ExpectCheck {
+  bool verdict = false, kind = false, location = false, parameter = true, also = true;
+  double parameter_error = 0;  ///< relative
+  std::string words;
+  bool ok() const { return verdict && kind && location && parameter && also; }
+};
+ExpectCheck check_expectation(const DiscoverSpec::Expect& e, const DiscoverySummary& s);
+
+nlohmann::ordered_json discovery_json(const Case& c, const DiscoveryData& d, const DiscoverySummary& s,
+                                      const ExpectCheck* check);
+
+/// Four panels: residual-force map on the structure, candidate ranking, frequency errors before/after, MAC
+/// before/after.
+plot::Figure discovery_figure(const Case& c, const DiscoverySummary& s);
+
+}  // namespace dynid

@@ -1,0 +1,205 @@
+// The `discover:` section of a case file, and the measured data it names.
+#include <filesystem>
+
+#include "dynid/engine/identify.hpp"
+#include "dynid/io/case_file.hpp"
+#include "dynid/io/discover_io.hpp"
+#include "dynid/io/modal_data_io.hpp"
+#include "dynid/io/test_data.hpp"
+#include "dynid/io/uff.hpp"
+#include "internal/case_util.hpp"
+#include "internal/model_yaml.hpp"
+
+namespace fs = std::filesystem;
+
+namespace dynid::internal {
+
+namespace {
+std::vector<int> ints(const YAML::Node& n, const YamlCtx& ctx, const std::string& what) {
+  ctx.require_sequence(n, what);
+  std::vector<int> out;
+  for (const auto& v : n) out.push_back(ctx.integer(v, what));
+  return out;
+}
+
+DiscoverSpec::Expect parse_expect(const YAML::Node& n, const YamlCtx& ctx, bool top) {
+  ctx.require_map(n, "discover expect");
+  if (top) ctx.only_keys(n, "discover expect", {"kind", "nodes", "elements", "parameter", "value", "tolerance", "verdict", "also"});
+  else ctx.only_keys(n, "discover expect also", {"kind", "nodes", "elements", "parameter", "value", "tolerance"});
+  DiscoverSpec::Expect e;
+  if (n["verdict"]) e.verdict = ctx.string(n["verdict"], "expect verdict");
+  if (e.verdict != "missing_physics" && e.verdict != "consistent" && e.verdict != "inconclusive")
+    ctx.fail(n["verdict"], "expect: verdict must be missing_physics, consistent or inconclusive");
+  if (e.verdict == "missing_physics" && !n["kind"]) ctx.fail(n, "expect: kind is missing (e.g. kind: semi_rigid_joint)");
+  if (n["kind"]) e.kind = ctx.string(n["kind"], "expect kind");
+  if (n["nodes"]) e.nodes = ints(n["nodes"], ctx, "expect nodes");
+  if (n["elements"]) e.elements = ints(n["elements"], ctx, "expect elements");
+  if (n["parameter"]) e.parameter = ctx.string(n["parameter"], "expect parameter");
+  if (n["value"]) e.value = ctx.number(n["value"], "expect value");
+  if (n["tolerance"]) e.tolerance = ctx.number(n["tolerance"], "expect tolerance");
+  if (n["parameter"] && !n["value"]) ctx.fail(n, "expect: parameter without value");
+  if (n["also"]) {
+    ctx.require_sequence(n["also"], "expect also");
+    for (const auto& a : n["also"]) e.also.push_back(parse_expect(a, ctx, false));
+  }
+  return e;
+}
+}  // namespace
+
+DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir) {
+  ctx.require_map(n, "discover");
+  ctx.only_keys(n, "discover", {"measured", "recordings", "identify", "truth", "modes", "min_mpc", "frequency_noise", "shape_noise",
+                                "kinds", "sensor_nodes", "suspension_nodes", "max_effects", "screen", "seeds", "expect"});
+  DiscoverSpec d;
+  const int sources = !!n["measured"] + !!n["recordings"] + !!n["truth"];
+  if (sources != 1) ctx.fail(n, "discover: give exactly one of measured: FILE (modal data), recordings: [FILES] or truth: {model:, test:}");
+  if (n["measured"]) d.measured_file = resolve(dir, ctx.string(n["measured"], "discover measured"));
+  if (n["recordings"]) {
+    const YAML::Node& r = n["recordings"];
+    if (r.IsScalar()) d.recordings.push_back(resolve(dir, ctx.string(r, "discover recordings")));
+    else {
+      ctx.require_sequence(r, "discover recordings");
+      for (const auto& f : r) d.recordings.push_back(resolve(dir, ctx.string(f, "discover recordings")));
+    }
+  }
+  if (n["identify"]) {
+    const YAML::Node& id = n["identify"];
+    ctx.require_map(id, "discover identify");
+    ctx.only_keys(id, "discover identify", {"method", "band_hz", "orders"});
+    if (id["method"]) {
+      d.method = ctx.string(id["method"], "identify method");
+      if (d.method != "lscf" && d.method != "ssi") ctx.fail(id["method"], "identify: method must be lscf or ssi");
+    }
+    if (id["band_hz"]) {
+      const std::vector<double> b = ctx.numbers(id["band_hz"], "identify band_hz");
+      if (b.size() != 2 || !(b[0] >= 0 && b[1] > b[0])) ctx.fail(id["band_hz"], "identify band_hz: expected [lo, hi] with 0 <= lo < hi (Hz)");
+      d.identify.band_lo_hz = b[0];
+      d.identify.band_hi_hz = b[1];
+    }
+    if (id["orders"]) {
+      const std::vector<double> o = ctx.numbers(id["orders"], "identify orders");
+      if (o.size() != 2) ctx.fail(id["orders"], "identify: orders must be [min, max]");
+      d.identify.min_order = static_cast<int>(o[0]);
+      d.identify.max_order = static_cast<int>(o[1]);
+    }
+    std::string why;
+    if (!d.identify.IsValid(&why)) ctx.fail(id, "identify: " + why);
+  }
+  if (n["truth"]) {
+    const YAML::Node& t = n["truth"];
+    ctx.require_map(t, "discover truth");
+    ctx.only_keys(t, "discover truth", {"model", "test"});
+    if (!t["model"] || !t["test"]) ctx.fail(t, "discover truth: needs model: (the structure as it really is) and test: (the virtual test)");
+    YamlCtx tctx = ctx;
+    std::string tdir = dir;
+    const YAML::Node m = model_node(t, &tctx, &tdir, 0);
+    d.truth = std::make_shared<Model>(parse_model(m, tctx, tdir, nullptr));
+    d.truth_test = std::make_shared<TestSpec>(parse_test(t["test"], ctx, *d.truth, dir));
+    // The analysis model must know every sensor (the recordings are labelled with the truth's node ids).
+    for (const MeasuredDof& s : d.truth_test->options.sensors)
+      if (model.node_index(s.node) < 0)
+        ctx.fail(t["test"], "discover truth: sensor " + to_string(s) + " is on a node the analysis model does not have");
+  }
+  if (n["modes"]) d.modes = ctx.integer(n["modes"], "discover modes");
+  if (n["min_mpc"]) d.min_mpc = ctx.number(n["min_mpc"], "discover min_mpc");
+  DiscoveryOptions& o = d.options;
+  if (n["frequency_noise"]) o.frequency_noise = ctx.number(n["frequency_noise"], "discover frequency_noise");
+  if (n["shape_noise"]) o.shape_noise = ctx.number(n["shape_noise"], "discover shape_noise");
+  if (n["kinds"]) {
+    ctx.require_sequence(n["kinds"], "discover kinds");
+    for (const auto& k : n["kinds"]) o.kinds.push_back(ctx.string(k, "discover kinds"));
+  }
+  if (n["sensor_nodes"]) o.sensor_nodes = ints(n["sensor_nodes"], ctx, "discover sensor_nodes");
+  if (n["suspension_nodes"]) o.suspension_nodes = ints(n["suspension_nodes"], ctx, "discover suspension_nodes");
+  if (n["max_effects"]) o.max_effects = ctx.integer(n["max_effects"], "discover max_effects");
+  if (n["screen"]) o.screen_fit = ctx.integer(n["screen"], "discover screen");
+  if (n["seeds"]) d.seeds = ctx.integer(n["seeds"], "discover seeds");
+  if (d.seeds < 1) ctx.fail(n["seeds"], "discover: seeds must be >= 1");
+  if (d.seeds > 1 && !d.truth) ctx.fail(n["seeds"], "discover: seeds (a robustness study) needs a truth: model");
+  std::string why;
+  if (!o.IsValid(&why)) ctx.fail(n, "discover: " + why);
+  if (n["expect"]) d.expect = parse_expect(n["expect"], ctx, true);
+  return d;
+}
+
+}  // namespace dynid::internal
+
+namespace dynid {
+
+namespace {
+ModalData keep_modes(ModalData m, const DiscoverSpec& d, std::vector<std::string>* notes) {
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index k = 0; k < m.frequencies_hz.size(); ++k) {
+    if (m.mpc.size() == m.frequencies_hz.size() && m.mpc[k] < d.min_mpc) {
+      if (notes) notes->push_back("identified mode at " + std::to_string(m.frequencies_hz[k]) + " Hz left out: MPC " + std::to_string(m.mpc[k]) + " < " + std::to_string(d.min_mpc) + " (not a normal mode)");
+      continue;
+    }
+    keep.push_back(k);
+  }
+  if (d.modes > 0 && static_cast<int>(keep.size()) > d.modes) keep.resize(static_cast<std::size_t>(d.modes));
+  ModalData o = m;
+  const Eigen::Index n = static_cast<Eigen::Index>(keep.size());
+  o.frequencies_hz.resize(n);
+  o.shapes.resize(m.shapes.rows(), n);
+  auto pick = [&](const Eigen::VectorXd& src, Eigen::VectorXd* dst) {
+    if (src.size() != m.frequencies_hz.size()) return;
+    dst->resize(n);
+    for (Eigen::Index j = 0; j < n; ++j) (*dst)[j] = src[keep[static_cast<std::size_t>(j)]];
+  };
+  for (Eigen::Index j = 0; j < n; ++j) {
+    o.frequencies_hz[j] = m.frequencies_hz[keep[static_cast<std::size_t>(j)]];
+    o.shapes.col(j) = m.shapes.col(keep[static_cast<std::size_t>(j)]);
+  }
+  pick(m.damping_ratios, &o.damping_ratios);
+  pick(m.mpc, &o.mpc);
+  pick(m.frequency_std_hz, &o.frequency_std_hz);
+  pick(m.damping_std, &o.damping_std);
+  return o;
+}
+}  // namespace
+
+DiscoveryData discovery_data(const Case& c, int seed_offset) {
+  if (!c.discover) throw InputError(c.path + ": the case has no discover: section (see docs/case-file.md)");
+  const DiscoverSpec& d = *c.discover;
+  DiscoveryData out;
+  if (!d.measured_file.empty()) {
+    const std::string ext = fs::path(d.measured_file).extension().string();
+    if (ext == ".json") out.measured = read_modal_data(d.measured_file);
+    else out.measured = uff_modal_data(read_uff(d.measured_file));
+    out.source = d.measured_file;
+  } else {
+    std::vector<Recording> recs;
+    if (d.truth) {
+      const TestSpec& t = *d.truth_test;
+      VirtualTestOptions vo = t.options;
+      vo.seed += static_cast<std::uint64_t>(seed_offset);
+      EigenOptions eo;
+      eo.band_lo = 0;
+      eo.band_hi = hz_to_eigenvalue(t.max_frequency_hz > 0 ? t.max_frequency_hz : 0.6 * vo.sample_rate_hz);
+      const ModalResult modes = modal_analysis(*d.truth, eo);
+      if (!modes.ok()) throw NumericalError(c.path + ": modal analysis of the truth model failed: " + modes.summary.message);
+      VirtualTest vt = simulate_test(*d.truth, modes, vo);
+      recs = std::move(vt.recordings);
+      out.truth_modes = std::move(vt.modes);
+      out.source = "virtual test of the truth model (seed " + std::to_string(vo.seed) + ")";
+    } else {
+      for (const std::string& f : d.recordings) {
+        TestData td = read_test_data(f);
+        if (td.kind == TestData::Kind::kUff) recs.push_back(uff_recording(td.uff));
+        else if (td.kind == TestData::Kind::kTimeHistory) recs.push_back(std::move(td.recording));
+        else throw InputError(f + ": not a time recording (UFF 58 type 1, or a time table)");
+      }
+      out.source = d.recordings[0] + (d.recordings.size() > 1 ? " ..." : "");
+    }
+    const std::string method = d.truth ? (d.method.empty() ? d.truth_test->method : d.method) : d.method;
+    IdentificationOptions io = d.identify;
+    if (d.truth && io.band_hi_hz == 0) io = d.truth_test->identify;
+    out.identification = identify_recordings(std::move(recs), method, io);
+    out.identified = true;
+    out.measured = out.identification.modal_data("identified from " + out.source);
+  }
+  out.measured = keep_modes(std::move(out.measured), d, &out.notes);
+  return out;
+}
+
+}  // namespace dynid
