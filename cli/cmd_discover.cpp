@@ -46,8 +46,10 @@ void print_summary(const Case& c, const DiscoveryData& d, const DiscoverySummary
   fmt::print("       {:>4}  {:<22} {:<28} {:>9.1f} {:>9.3f} {:>8.5f}\n", "-", "global_recalibration", "global (E, rho)", r.delta_bic,
              r.max_freq_error_pct, r.mean_mac);
   fmt::print("  4. verdict: {}\n     {}\n", s.verdict, s.explanation);
-  fmt::print("     fit: max frequency error {:.3f} % -> {:.3f} %, mean MAC {:.5f} -> {:.5f} ({} eigen-solves, {:.1f} s)\n",
-             s.before.max_freq_error_pct, s.after.max_freq_error_pct, s.before.mean_mac, s.after.mean_mac, s.eigen_solves, s.seconds);
+  fmt::print("     fit: max frequency error {:.3f} % -> {:.3f} %, mean MAC {:.5f} -> {:.5f}{} ({} eigen-solves, {:.1f} s)\n",
+             s.before.max_freq_error_pct, s.after.max_freq_error_pct, s.before.mean_mac, s.after.mean_mac,
+             s.before.unpaired ? fmt::format(", measured modes without a model counterpart {} -> {}", s.before.unpaired, s.after.unpaired) : std::string(),
+             s.eigen_solves, s.seconds);
 }
 
 int run_discover(const DiscoverArgs& a, const GlobalOptions& g) {
@@ -120,7 +122,8 @@ int run_discover(const DiscoverArgs& a, const GlobalOptions& g) {
                  100.0 * j["robustness"]["rate"].get<double>());
     fmt::print("  wrote {}, {}\n", json, png);
   }
-  return 0;
+  // Exit code 4: the case states what the answer should be (expect:) and this is not it (test suites).
+  return check && !check->ok() ? 4 : 0;
 }
 
 }  // namespace

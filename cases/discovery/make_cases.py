@@ -372,7 +372,7 @@ def beams():
     sensors_n = [3, 5, 7, 9, 11]
     t.masses = [(n, 0.006) for n in sensors_n]
     beam_case("beam-sensor-mass", "Accelerometers (6 g each) loading a light cantilever.", hdr, hdr, a, t,
-              [f"{n}uy" for n in sensors_n], ["11uy"], 2048, 8, (2, 800),
+              [f"{n}uy" for n in sensors_n], ["11uy"], 2048, 8, (2, 420),
               "{kind: sensor_mass, parameter: mass per sensor, value: 0.006}", 21, "five 6 g point masses at the sensor nodes")
 
     # 8. shear deformation: a deep steel beam (2 m span, 400 x 100 mm, L/h = 5), simply supported; truth in

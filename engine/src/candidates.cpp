@@ -44,7 +44,13 @@ CustomTerm linear_term(std::vector<int> dofs, Eigen::MatrixXd AK, Eigen::MatrixX
   return t;
 }
 
-// Structural (beam/frame) element matrices without point masses or springs.
+bool is_member(const Model& model, int e) {
+  const ElementType t = model.elements()[e].type;
+  return t == ElementType::Beam2D || t == ElementType::Frame2D || t == ElementType::Frame3D;
+}
+
+// An element's stiffness (without geometric stiffness: Ks) and mass matrices; beams and frames also their
+// bending part and section properties.
 struct Member {
   int e = -1;
   std::vector<int> dofs;
@@ -59,12 +65,13 @@ Member member(const Model& model, int e) {
   model.element_dofs(e, &m.dofs);
   m.types = model.element_dof_types(e);
   const ElementParts p = model.element_parts(e);
-  m.Ks = p.K_axial + p.K_bending + p.K_torsion;
+  m.Ks = p.K_axial + p.K_bending + p.K_torsion + p.K_discrete;
   m.K = m.Ks + p.K_geometric;
-  m.M = p.M_translational + p.M_rotary;
+  m.M = p.M_translational + p.M_rotary + p.M_discrete;
   m.Kb = p.K_bending;
   m.Mt = p.M_translational;
   const Element& el = model.elements()[e];
+  if (!is_member(model, e)) return m;  // springs and point masses: matrices only
   const Material& mat = model.materials()[el.material];
   const Section& sec = model.sections()[el.section];
   const auto& n = model.element_nodes(e);
@@ -76,10 +83,6 @@ Member member(const Model& model, int e) {
   return m;
 }
 
-bool is_member(const Model& model, int e) {
-  const ElementType t = model.elements()[e].type;
-  return t == ElementType::Beam2D || t == ElementType::Frame2D || t == ElementType::Frame3D;
-}
 
 
 // ---- lumped mass at a node ----------------------------------------------------------------------------------
@@ -230,6 +233,11 @@ class EndRelease : public Candidate {
 class ElementChange : public Candidate {
  public:
   ElementChange(const Model& m, int e, bool mass) : e_(e), eid_(m.elements()[e].id), mass_(mass) {}
+  // Springs only change stiffness, point masses only mass.
+  static bool applies(const Model& m, int e, bool mass) {
+    const ElementType t = m.elements()[e].type;
+    return t == ElementType::Spring ? !mass : t == ElementType::PointMass ? mass : true;
+  }
   std::string kind() const override { return mass_ ? "element_mass" : "element_stiffness"; }
   std::string description() const override {
     return std::string(mass_ ? "mass" : "stiffness") + " change of element " + std::to_string(eid_);
@@ -460,7 +468,7 @@ class Recalibration : public Candidate {
  public:
   Recalibration(const Model& m, std::vector<int> els) : els_(std::move(els)), site_(group_site(m, els_)) {}
   std::string kind() const override { return "global_recalibration"; }
-  std::string description() const override { return "recalibrate Young's modulus and density of all members"; }
+  std::string description() const override { return "recalibrate the stiffness (E) and mass (rho) of the whole model"; }
   Site site() const override { return site_; }
   bool global() const override { return true; }
   std::vector<CandidateParameter> parameters() const override { return {{"E change", 0.0, -0.9, 3.0}, {"rho change", 0.0, -0.9, 3.0}}; }
@@ -488,7 +496,9 @@ class Recalibration : public Candidate {
 }  // namespace
 
 std::unique_ptr<Candidate> make_recalibration(const Model& model) {
-  return std::make_unique<Recalibration>(model, group_members(model, ""));
+  std::vector<int> all(static_cast<std::size_t>(model.num_elements()));
+  for (int e = 0; e < model.num_elements(); ++e) all[static_cast<std::size_t>(e)] = e;
+  return std::make_unique<Recalibration>(model, all);
 }
 
 std::vector<std::unique_ptr<Candidate>> library(const Model& model, const ModalData& measured, const DiscoveryOptions& o) {
@@ -505,19 +515,22 @@ std::vector<std::unique_ptr<Candidate>> library(const Model& model, const ModalD
   const int nn = static_cast<int>(model.nodes().size());
   // Node degree (members at each node) and total structural mass (reference scales).
   std::vector<std::vector<std::pair<int, int>>> ends(static_cast<std::size_t>(nn));  // (element, end)
+  std::vector<char> used(static_cast<std::size_t>(nn), 0);
   double mass = 0;
   for (int e = 0; e < model.num_elements(); ++e) {
+    for (int k = 0; k < model.elements()[e].num_nodes; ++k) used[model.element_nodes(e)[k]] = 1;
+    if (model.elements()[e].type == ElementType::PointMass) mass += model.elements()[e].mass;
     if (!is_member(model, e)) continue;
     for (int k = 0; k < 2; ++k) ends[model.element_nodes(e)[k]].push_back({e, k});
     const Member mb = member(model, e);
     mass += mb.rhoA * mb.L;
   }
-  int with_members = 0;
-  for (const auto& v : ends) with_members += !v.empty();
-  const double mref = mass / std::max(with_members, 1);
+  int with_elements = 0;
+  for (char u : used) with_elements += u;
+  const double mref = mass / std::max(with_elements, 1);
   AssembledSystem sys = assemble_system(model);
   for (int n = 0; n < nn; ++n) {
-    if (ends[n].empty()) continue;
+    if (!used[n]) continue;
     auto lm = std::make_unique<LumpedMass>(model, n, mref);
     if (lm->ok()) add(std::move(lm));
     for (int t = 0; t < kNumDofTypes; ++t) {
@@ -543,11 +556,9 @@ std::vector<std::unique_ptr<Candidate>> library(const Model& model, const ModalD
       }
     }
   }
-  for (int e = 0; e < model.num_elements(); ++e) {
-    if (!is_member(model, e)) continue;
-    add(std::make_unique<ElementChange>(model, e, false));
-    add(std::make_unique<ElementChange>(model, e, true));
-  }
+  for (int e = 0; e < model.num_elements(); ++e)
+    for (bool m : {false, true})
+      if (ElementChange::applies(model, e, m)) add(std::make_unique<ElementChange>(model, e, m));
   // Global candidates.
   const std::vector<int> all = group_members(model, "");
   std::set<std::string> groups;

@@ -78,7 +78,15 @@ FitQuality quality_of(const Eigen::VectorXd& meas, const Eigen::VectorXd& model_
   q.model_hz = model_hz;
   q.mac = mac;
   q.chi2 = chi2;
-  q.max_freq_error_pct = meas.size() ? 100.0 * ((model_hz - meas).cwiseAbs().array() / meas.array()).maxCoeff() : 0.0;
+  // Frequency errors of the modes that pair (MAC >= 0.5); a measured mode without a counterpart in the model
+  // (a new local mode) is counted as unpaired instead of as an error against whatever mode it was forced to.
+  for (Eigen::Index k = 0; k < meas.size(); ++k) {
+    if (mac[k] < 0.5) {
+      ++q.unpaired;
+      continue;
+    }
+    q.max_freq_error_pct = std::max(q.max_freq_error_pct, 100.0 * std::abs(model_hz[k] - meas[k]) / meas[k]);
+  }
   q.mean_mac = mac.size() ? mac.mean() : 0.0;
   return q;
 }
@@ -374,17 +382,23 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
 
   const bool misfit = S.chi2_per_datum_before > options.min_misfit;
   if (S.candidates.empty() || !misfit || !(S.candidates[0].delta_bic > options.decisive)) {
-    S.verdict = "consistent";
-    S.explanation = "No missing physics found: ";
+    // Consistent only when the model fits within the noise; a misfit that no candidate explains is inconclusive.
+    S.verdict = misfit ? "inconclusive" : "consistent";
+    S.explanation = misfit ? "The model misfits the data (chi-square per datum: frequencies " + fmt_value(S.chi2_frequency_before, 3) +
+                                 ", shapes " + fmt_value(S.chi2_shape_before, 3) + "; max frequency error " +
+                                 fmt_value(S.before.max_freq_error_pct, 3) + " %) but " :
+                           "No missing physics found: ";
     if (!misfit)
       S.explanation += "the model fits the data within the stated noise (chi-square per datum: frequencies " +
                        fmt_value(S.chi2_frequency_before, 3) + ", shapes " + fmt_value(S.chi2_shape_before, 3) +
                        " <= " + fmt_value(options.min_misfit, 3) + "; max frequency error " + fmt_value(S.before.max_freq_error_pct, 3) +
                        " %, mean MAC " + fmt_value(S.before.mean_mac, 5) + ").";
     else
-      S.explanation += "no candidate improves the fit decisively (best: " + (S.candidates.empty() ? std::string("none") : S.candidates[0].description) +
-                       ", BIC improvement " + fmt_value(S.candidates.empty() ? 0.0 : S.candidates[0].delta_bic, 3) + " < " +
-                       fmt_value(options.decisive, 3) + ").";
+      S.explanation += "no candidate in the library explains it decisively (best: " +
+                       (S.candidates.empty() ? std::string("none") : S.candidates[0].description) + ", BIC improvement " +
+                       fmt_value(S.candidates.empty() ? 0.0 : S.candidates[0].delta_bic, 3) + " < " + fmt_value(options.decisive, 3) +
+                       "). More modes or more measured DOFs would constrain the candidates; an effect outside the library "
+                       "(e.g. several properties off at once) is also possible.";
     S.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return S;
   }

@@ -50,6 +50,17 @@ std::string location_words(const Site& s) {
   return w;
 }
 
+std::string short_kind(const std::string& k) {
+  static const std::pair<const char*, const char*> names[] = {
+      {"semi_rigid_joint", "joint"},       {"flexible_support", "support"},  {"lumped_mass", "mass"},
+      {"element_stiffness", "EI"},         {"element_mass", "m"},            {"grounded_spring", "spring"},
+      {"rotational_spring", "rot.spring"}, {"shear_deformation", "shear"},   {"axial_preload", "preload"},
+      {"distributed_mass", "dist.mass"},   {"sensor_mass", "sensors"},       {"suspension_stiffness", "suspension"}};
+  for (const auto& [a, b] : names)
+    if (k == a) return b;
+  return k;
+}
+
 nlohmann::ordered_json location_json(const ScoredHypothesis& h) {
   nlohmann::ordered_json j;
   j["nodes"] = h.global ? std::vector<int>{} : h.site.nodes;
@@ -70,6 +81,7 @@ nlohmann::ordered_json values_json(const std::vector<PhysicalValue>& v, bool std
 nlohmann::ordered_json quality_json(const FitQuality& q) {
   nlohmann::ordered_json j;
   j["max_freq_error_pct"] = q.max_freq_error_pct;
+  j["unpaired_modes"] = q.unpaired;
   j["mean_mac"] = q.mean_mac;
   j["chi2"] = q.chi2;
   j["measured_hz"] = std::vector<double>(q.measured_hz.data(), q.measured_hz.data() + q.measured_hz.size());
@@ -199,10 +211,10 @@ plot::Figure discovery_figure(const Case& c, const DiscoverySummary& s) {
   f.rows = 2;
   f.cols = 2;
   f.width = 1600;
-  f.height = 1100;
+  f.height = 1250;
   // (1) residual-force map on the structure: members as lines, measured nodes sized by their share.
   plot::Panel map;
-  map.title = "Where: residual force share per measured node (SEREP-reduced)";
+  map.title = "Where: residual-force share per measured node";
   map.xlabel = "x";
   map.ylabel = "y";
   // A beam along x is drawn with its nodes' share as the height; frames in their plane.
@@ -270,7 +282,7 @@ plot::Figure discovery_figure(const Case& c, const DiscoverySummary& s) {
 
   // (2) candidates ranked by evidence (BIC improvement over the model as given).
   plot::Panel rank;
-  rank.title = "Why: candidates ranked by evidence (BIC improvement; > 10 decisive)";
+  rank.title = "Why: candidates by evidence (BIC gain)";
   rank.ylabel = "BIC improvement";
   plot::Series good, rest, recal;
   good.kind = rest.kind = recal.kind = plot::Kind::kBars;
@@ -288,23 +300,28 @@ plot::Figure discovery_figure(const Case& c, const DiscoverySummary& s) {
     t.x.push_back(k + 1);
     t.y.push_back(h.fitted ? h.delta_bic : 0.0);
     lo = std::min(lo, h.fitted ? h.delta_bic : 0.0);
-    std::string lab = h.kind;
-    if (!h.global) lab += " " + location_words(h.site);
+    std::string lab = short_kind(h.kind);
+    if (!h.global) {
+      for (int n : h.site.nodes) lab += " n" + std::to_string(n);
+      for (int e : h.site.elements) lab += " e" + std::to_string(e);
+    } else {
+      lab += " [" + std::to_string(h.site.elements.size()) + " el]";
+    }
     rank.xticks.push_back({static_cast<double>(k + 1), lab});
   }
   recal.x.push_back(show + 1);
   recal.y.push_back(s.recalibration.fitted ? s.recalibration.delta_bic : 0.0);
-  rank.xticks.push_back({static_cast<double>(show + 1), "recalibration"});
+  rank.xticks.push_back({static_cast<double>(show + 1), "E, rho"});
   rank.series = {rest, good, recal};
   rank.hlines = {{10.0, "decisive"}};
   rank.ymin = std::min(lo, 0.0);
 
   // (3) frequency errors and (4) MAC, before and after.
   plot::Panel fe, mac;
-  fe.title = "Fit: frequency error per measured mode";
+  fe.title = "Fit: frequency error per mode";
   fe.ylabel = "model - measured [%]";
   fe.xlabel = "measured mode";
-  mac.title = "Fit: MAC per measured mode";
+  mac.title = "Fit: MAC per mode";
   mac.ylabel = "MAC";
   mac.xlabel = "measured mode";
   plot::Series fb, fa, mb, ma;
@@ -317,10 +334,21 @@ plot::Figure discovery_figure(const Case& c, const DiscoverySummary& s) {
   fb.color = mb.color = 0;
   fa.color = ma.color = 3;
   mb.kind = ma.kind = plot::Kind::kLineMarkers;
+  plot::Series lost;
+  lost.label = "x  no model counterpart (MAC < 0.5)";
+  lost.kind = plot::Kind::kMarkers;
+  lost.symbol = 5;
+  lost.symbol_scale = 2.0;
+  lost.color = 0;
   for (Eigen::Index k = 0; k < s.before.measured_hz.size(); ++k) {
     const double x = static_cast<double>(k + 1);
-    fb.x.push_back(x);
-    fb.y.push_back(100 * (s.before.model_hz[k] - s.before.measured_hz[k]) / s.before.measured_hz[k]);
+    if (s.before.mac[k] >= 0.5) {
+      fb.x.push_back(x);
+      fb.y.push_back(100 * (s.before.model_hz[k] - s.before.measured_hz[k]) / s.before.measured_hz[k]);
+    } else {
+      lost.x.push_back(x - 0.2);
+      lost.y.push_back(0.0);
+    }
     mb.x.push_back(x);
     mb.y.push_back(s.before.mac[k]);
     if (k < s.after.model_hz.size()) {
@@ -331,6 +359,7 @@ plot::Figure discovery_figure(const Case& c, const DiscoverySummary& s) {
     }
   }
   fe.series = {fb, fa};
+  if (!lost.x.empty()) fe.series.push_back(lost);
   fe.hlines = {{0.0, ""}};
   mac.series = {mb, ma};
   double mmin = 1;

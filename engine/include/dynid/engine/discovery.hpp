@@ -122,7 +122,9 @@ struct ScoredHypothesis {
 
 struct FitQuality {
   Eigen::VectorXd measured_hz, model_hz, mac;
-  double max_freq_error_pct = 0, mean_mac = 0, chi2 = 0;
+  double max_freq_error_pct = 0;  ///< over the modes that pair (MAC >= 0.5)
+  int unpaired = 0;                ///< measured modes with no model mode of MAC >= 0.5
+  double mean_mac = 0, chi2 = 0;
 };
 
 struct DiscoverySummary {
