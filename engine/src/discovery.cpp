@@ -259,6 +259,7 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   fo.shape_noise = options.shape_noise;
   fo.regularization = 0;
   fo.ties.clear();
+  fo.dense_max_dofs = std::min(fo.dense_max_dofs, 120);
   if (measured.frequency_std_hz.size() == measured.num_modes() && measured.num_modes() > 0) {
     // Identified data carry their own frequency scatter (over model orders): use its median when it is larger
     // than the floor (one poorly stabilised mode does not loosen every other).
@@ -346,8 +347,8 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return screening[x] > screening[y]; });
   std::vector<int> to_fit(order.begin(), order.begin() + std::min<std::size_t>(order.size(), static_cast<std::size_t>(options.screen_fit)));
   // The linear screening can mislead when a measured mode has no counterpart in the model (a new local mode):
-  // the node-site candidates at the two nodes carrying most residual force are fitted too.
-  for (std::size_t t = 0; t < S.localization.nodes.size() && t < 2; ++t)
+  // the node-site candidates at the three nodes carrying most residual force are fitted too.
+  for (std::size_t t = 0; t < S.localization.nodes.size() && t < 3; ++t)
     for (int k : local)
       if (lib[k]->site().nodes.size() == 1 && lib[k]->site().nodes[0] == S.localization.nodes[t].node &&
           std::find(to_fit.begin(), to_fit.end(), k) == to_fit.end())
@@ -403,92 +404,112 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
     return S;
   }
 
+  // The misfit left is within the noise: nothing further to explain.
+  auto explained = [&](const SetFit& f) {
+    return f.chi2 / n <= options.min_misfit && f.quality.max_freq_error_pct < 300 * fo.frequency_noise;
+  };
+  auto grow = [&](std::vector<const Candidate*>& chosen, SetFit& chosen_fit, double& chosen_bic) {
+    for (int effect = 1; effect < options.max_effects; ++effect) {
+      // Re-screen the local candidates with the chosen effects in the model (their parameters refitted).
+      std::vector<const Candidate*> set = chosen;
+      std::vector<int> others;
+      for (int k : local) {
+        bool used = false;
+        for (const Candidate* c : chosen) used = used || c == lib[k].get();
+        if (!used) {
+          set.push_back(lib[k].get());
+          others.push_back(k);
+        }
+      }
+      Installed in = install(model, set);
+      Eigen::VectorXd th = in.pm->nominal();
+      int nc = 0;
+      for (std::size_t k = 0; k < chosen.size(); ++k) {
+        th.segment(in.first[k], chosen_fit.theta[k].size()) = chosen_fit.theta[k];
+        nc += static_cast<int>(chosen_fit.theta[k].size());
+      }
+      Linearization l2;
+      try {
+        l2 = linearize(*in.pm, measured, th, fo);
+      } catch (const std::exception&) {
+        break;
+      }
+      ++S.eigen_solves;
+      const Eigen::MatrixXd C = l2.J.leftCols(nc);
+      std::vector<std::pair<double, int>> sc;
+      for (std::size_t k = 0; k < others.size(); ++k) {
+        const int col = in.first[chosen.size() + k];
+        sc.push_back({drop(l2.J, l2.r, col, &C, in.pm->parameter(col)), others[k]});
+      }
+      std::stable_sort(sc.begin(), sc.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+      std::vector<int> tries;
+      for (std::size_t k = 0; k < sc.size() && static_cast<int>(k) < std::max(2, options.screen_fit / 2); ++k) tries.push_back(sc[k].second);
+      for (int g : global) {
+        bool used = false;
+        for (const Candidate* c : chosen) used = used || c == lib[g].get();
+        if (!used) tries.push_back(g);
+      }
+      std::vector<SetFit> f2(tries.size());
+  #pragma omp parallel for schedule(dynamic)
+      for (int k = 0; k < static_cast<int>(tries.size()); ++k) {
+        std::vector<const Candidate*> s2 = chosen;
+        s2.push_back(lib[tries[k]].get());
+        f2[k] = fit_set(model, measured, s2, chosen_fit.theta, fo);
+      }
+      int best = -1;
+      double best_bic = chosen_bic - options.decisive;
+      // A further effect only while the misfit left is beyond the noise, and only with parameters that the data
+      // determine (|theta| > min_significance std, a posteriori).
+      if (explained(chosen_fit)) break;
+      for (std::size_t k = 0; k < tries.size(); ++k) {
+        S.eigen_solves += f2[k].evaluations;
+        if (!f2[k].ok) continue;
+        int ptot = 0;
+        for (const Candidate* c : chosen) ptot += static_cast<int>(c->parameters().size());
+        ptot += static_cast<int>(lib[tries[k]]->parameters().size());
+        if (significance(f2[k], chosen.size(), *lib[tries[k]], n, ptot) < options.min_significance) continue;
+        int np = 0;
+        double pen = 0;
+        for (const Candidate* c : chosen) {
+          np += static_cast<int>(c->parameters().size());
+          pen += penalty(*c);
+        }
+        np += static_cast<int>(lib[tries[k]]->parameters().size());
+        pen += penalty(*lib[tries[k]]);
+        const double b = bic(f2[k].chi2, n, np, pen);
+        if (b < best_bic) {
+          best_bic = b;
+          best = static_cast<int>(k);
+        }
+      }
+      if (best < 0) break;
+      chosen.push_back(lib[tries[best]].get());
+      chosen_fit = f2[best];
+      chosen_bic = best_bic;
+    }
+  };
+
   // ---- greedy: add further effects while the score improves decisively ----
-  const Candidate* first = nullptr;
-  for (int k : rank) {
-    first = lib[to_fit[k]].get();
-    break;
-  }
-  std::vector<const Candidate*> chosen = {first};
-  SetFit chosen_fit = fits[rank[0]];
-  double chosen_bic = S.candidates[0].bic;
-  for (int effect = 1; effect < options.max_effects; ++effect) {
-    // Re-screen the local candidates with the chosen effects in the model (their parameters refitted).
-    std::vector<const Candidate*> set = chosen;
-    std::vector<int> others;
-    for (int k : local) {
-      bool used = false;
-      for (const Candidate* c : chosen) used = used || c == lib[k].get();
-      if (!used) {
-        set.push_back(lib[k].get());
-        others.push_back(k);
-      }
+  // A small beam search: when the growth from the best single effect still leaves a misfit beyond the noise
+  // (two effects at once can make the best single one a compromise that misleads the growth), it also starts
+  // from the second and third best single effects, and the best final combination is kept. When the best
+  // single effect's growth explains the data to the noise, the alternatives are not explored: more effects
+  // fitting systematic identification errors must not outbid a complete, simpler explanation.
+  std::vector<const Candidate*> chosen;
+  SetFit chosen_fit;
+  double chosen_bic = std::numeric_limits<double>::infinity();
+  for (int start = 0; start < std::min<int>(3, static_cast<int>(rank.size())); ++start) {
+    if (!S.candidates[static_cast<std::size_t>(start)].fitted) continue;
+    if (start > 0 && (explained(chosen_fit) || !(S.candidates[static_cast<std::size_t>(start)].delta_bic > options.decisive))) break;
+    std::vector<const Candidate*> grown = {lib[to_fit[rank[static_cast<std::size_t>(start)]]].get()};
+    SetFit grown_fit = fits[rank[static_cast<std::size_t>(start)]];
+    double grown_bic = S.candidates[static_cast<std::size_t>(start)].bic;
+    grow(grown, grown_fit, grown_bic);
+    if (grown_bic < chosen_bic) {
+      chosen = grown;
+      chosen_fit = grown_fit;
+      chosen_bic = grown_bic;
     }
-    Installed in = install(model, set);
-    Eigen::VectorXd th = in.pm->nominal();
-    int nc = 0;
-    for (std::size_t k = 0; k < chosen.size(); ++k) {
-      th.segment(in.first[k], chosen_fit.theta[k].size()) = chosen_fit.theta[k];
-      nc += static_cast<int>(chosen_fit.theta[k].size());
-    }
-    Linearization l2;
-    try {
-      l2 = linearize(*in.pm, measured, th, fo);
-    } catch (const std::exception&) {
-      break;
-    }
-    ++S.eigen_solves;
-    const Eigen::MatrixXd C = l2.J.leftCols(nc);
-    std::vector<std::pair<double, int>> sc;
-    for (std::size_t k = 0; k < others.size(); ++k) {
-      const int col = in.first[chosen.size() + k];
-      sc.push_back({drop(l2.J, l2.r, col, &C, in.pm->parameter(col)), others[k]});
-    }
-    std::stable_sort(sc.begin(), sc.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
-    std::vector<int> tries;
-    for (std::size_t k = 0; k < sc.size() && static_cast<int>(k) < std::max(2, options.screen_fit / 2); ++k) tries.push_back(sc[k].second);
-    for (int g : global) {
-      bool used = false;
-      for (const Candidate* c : chosen) used = used || c == lib[g].get();
-      if (!used) tries.push_back(g);
-    }
-    std::vector<SetFit> f2(tries.size());
-#pragma omp parallel for schedule(dynamic)
-    for (int k = 0; k < static_cast<int>(tries.size()); ++k) {
-      std::vector<const Candidate*> s2 = chosen;
-      s2.push_back(lib[tries[k]].get());
-      f2[k] = fit_set(model, measured, s2, chosen_fit.theta, fo);
-    }
-    int best = -1;
-    double best_bic = chosen_bic - options.decisive;
-    // A further effect only while the misfit left is beyond the noise, and only with parameters that the data
-    // determine (|theta| > min_significance std, a posteriori).
-    if (chosen_fit.chi2 / n <= options.min_misfit && chosen_fit.quality.max_freq_error_pct < 300 * fo.frequency_noise) break;
-    for (std::size_t k = 0; k < tries.size(); ++k) {
-      S.eigen_solves += f2[k].evaluations;
-      if (!f2[k].ok) continue;
-      int ptot = 0;
-      for (const Candidate* c : chosen) ptot += static_cast<int>(c->parameters().size());
-      ptot += static_cast<int>(lib[tries[k]]->parameters().size());
-      if (significance(f2[k], chosen.size(), *lib[tries[k]], n, ptot) < options.min_significance) continue;
-      int np = 0;
-      double pen = 0;
-      for (const Candidate* c : chosen) {
-        np += static_cast<int>(c->parameters().size());
-        pen += penalty(*c);
-      }
-      np += static_cast<int>(lib[tries[k]]->parameters().size());
-      pen += penalty(*lib[tries[k]]);
-      const double b = bic(f2[k].chi2, n, np, pen);
-      if (b < best_bic) {
-        best_bic = b;
-        best = static_cast<int>(k);
-      }
-    }
-    if (best < 0) break;
-    chosen.push_back(lib[tries[best]].get());
-    chosen_fit = f2[best];
-    chosen_bic = best_bic;
   }
 
   // ---- findings ----

@@ -84,7 +84,7 @@ class Evaluator {
     const int rigid = static_cast<int>(eo.rigid_body_basis.cols());
     int want = rigid + p + o.extra_modes;
     if (o.objective == FitObjective::kSerep) want = std::max(want, static_cast<int>(rows_.size()) + rigid);
-    if (n <= 400) {  // small model: every mode, dense, exact expansions
+    if (n <= o.dense_max_dofs) {  // small model: every mode, dense, exact expansions
       eo.method = EigenOptions::Method::kDense;
       eo.num_modes = n;
       complete_ = true;

@@ -67,7 +67,7 @@ struct DiscoveryOptions {
   /// Noise levels used to whiten the residuals: measured frequencies (relative std) and shape entries (std
   /// relative to each mode's largest entry). Identified data give their own frequency spread; these are floors.
   double frequency_noise = 1e-3, shape_noise = 5e-2;
-  int screen_fit = 8;              ///< local candidates fitted in full after the linear screening
+  int screen_fit = 16;             ///< local candidates fitted in full after the linear screening
   int max_effects = 3;             ///< greedy: at most this many effects combined
   /// Decisive evidence (BIC difference; 10 = "very strong" on the Kass-Raftery scale) for a finding and for each
   /// further effect; an alternative within `ambiguity` of the best makes the verdict inconclusive.

@@ -41,6 +41,10 @@ struct FitOptions {
   double function_tolerance = 1e-8, parameter_tolerance = 1e-10, gradient_tolerance = 1e-14;
   double min_mac = 0.5;           ///< pairing threshold
   int extra_modes = 10;           ///< model modes computed beyond the measured ones (pairing, expansion)
+  /// Models up to this many DOFs are solved densely with every mode (exact shape derivatives); larger ones by
+  /// shift-invert Lanczos for the modes needed, shape derivatives with a static correction. With hundreds of
+  /// parameters (discovery's screening) the sparse path is the cheaper one well below 400 DOFs.
+  int dense_max_dofs = 400;
   bool covariance = true;
   /// Tied parameters: theta[p] = ratio * theta[q] for each (p, (q, ratio)); q must be free, p is not.
   std::vector<std::pair<int, std::pair<int, double>>> ties;
