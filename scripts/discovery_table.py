@@ -38,7 +38,8 @@ def main():
             j["case"], j["verdict"], first["kind"] if first else "—", loc, fmt_params(first) if first else "—",
             b["max_freq_error_pct"], a["max_freq_error_pct"], f"{gain:.0f}×" if first else "—", b["mean_mac"], a["mean_mac"],
             "yes" if ok else ("**no**" if ok is False else "—"),
-            f"{rob['as_expected']}/{rob['seeds']}" if rob else "—", j["cost"]["seconds"]))
+            f"{rob['as_expected']}/{rob['seeds']} (worst parameter error {100 * rob['worst_parameter_error']:.1f} %)" if rob else "—",
+            j["cost"]["seconds"]))
     head = ("| case | verdict | first finding | where | fitted | max freq. error % before → after (gain) | mean MAC before → after | "
             "as expected | robustness (seeds) | s |\n|---|---|---|---|---|---|---|---|---|---|")
     table = head + "\n" + "\n".join(rows) + "\n"

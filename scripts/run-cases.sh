@@ -2,7 +2,8 @@
 # Runs dynid on every bundled case (cases/**/*.yaml, found below, so new case folders need no entry here; this
 # includes the mesh-file cases paper-frame-gmsh and paper-frame-abaqus, whose models come from frame.msh and
 # frame.inp): `detect` for cases with a detect: section, `simulate-test` then `identify` for cases with a test:
-# section (cases/virtual-tests), `modal` otherwise. Results (JSON, and plots for
+# section (cases/virtual-tests), `discover` for cases with a discover: section (cases/discovery: exit code 4 if the
+# expected effect is not found), `modal` otherwise. Results (JSON, and plots for
 # detect) go to out/ (override with DYNID_OUT). This is the "main job" of the README's first command; each case
 # folder's README says what the case shows.
 set -euo pipefail
@@ -20,6 +21,10 @@ while IFS= read -r file; do
     band=$(sed -n 's/.*identify:.*band_hz: *\[\([0-9.]*\), *\([0-9.]*\)\].*/\1 \2/p' "$file")
     "$dynid" simulate-test "$file" -o "$out/$name.uff" --force &&
       "$dynid" identify $(ls "$out/$name"*.uff | grep -v -- '-modes.uff') ${band:+--band $band} --out "$out/$name" --force ||
+      { echo "!! $rel failed" >&2; status=1; }
+  elif grep -q '^discover:' "$file"; then
+    echo "== discover $rel"
+    "$dynid" discover "$file" --json "$out/$name.discover.json" --plot "$out/$name.discover.png" --force --quiet ||
       { echo "!! $rel failed" >&2; status=1; }
   elif grep -q '^detect:' "$file"; then
     echo "== detect $rel"

@@ -220,7 +220,16 @@ Localization locate(const Model& model, const ModalData& meas, const std::vector
   return L;
 }
 
-ScoredHypothesis scored(const Candidate& c, const SetFit& f, int n, double penalty) {
+// Physical values of a candidate, with SI unit labels or, for models in other consistent units, "model units".
+std::vector<PhysicalValue> values_of(const Candidate& c, const Eigen::VectorXd& th, const Eigen::VectorXd& sd, bool si) {
+  std::vector<PhysicalValue> v = c.physical(th, sd);
+  if (!si)
+    for (PhysicalValue& p : v)
+      if (!p.unit.empty() && p.unit != "%") p.unit = "(model units)";
+  return v;
+}
+
+ScoredHypothesis scored(const Candidate& c, const SetFit& f, int n, double penalty, bool si) {
   ScoredHypothesis h;
   h.kind = c.kind();
   h.description = c.description();
@@ -234,7 +243,7 @@ ScoredHypothesis scored(const Candidate& c, const SetFit& f, int n, double penal
   }
   h.chi2 = f.chi2;
   h.bic = bic(f.chi2, n, h.parameters, penalty);
-  h.values = c.physical(f.theta[0], f.stddev[0]);
+  h.values = values_of(c, f.theta[0], f.stddev[0], si);
   h.finding = c.finding(h.values);
   h.max_freq_error_pct = f.quality.max_freq_error_pct;
   h.mean_mac = f.quality.mean_mac;
@@ -259,7 +268,7 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   fo.shape_noise = options.shape_noise;
   fo.regularization = 0;
   fo.ties.clear();
-  fo.dense_max_dofs = std::min(fo.dense_max_dofs, 120);
+  fo.dense_max_dofs = std::min(fo.dense_max_dofs, 40);
   if (measured.frequency_std_hz.size() == measured.num_modes() && measured.num_modes() > 0) {
     // Identified data carry their own frequency scatter (over model orders): use its median when it is larger
     // than the floor (one poorly stabilised mode does not loosen every other).
@@ -363,13 +372,13 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   }
   for (std::size_t k = 0; k < to_fit.size(); ++k) {
     S.eigen_solves += fits[k].evaluations;
-    ScoredHypothesis h = scored(*lib[to_fit[k]], fits[k], n, penalty(*lib[to_fit[k]]));
+    ScoredHypothesis h = scored(*lib[to_fit[k]], fits[k], n, penalty(*lib[to_fit[k]]), options.si_units);
     h.screening = screening[to_fit[k]];
     h.delta_bic = bic0 - h.bic;
     S.candidates.push_back(std::move(h));
   }
   S.eigen_solves += recal_fit.evaluations;
-  S.recalibration = scored(*recal, recal_fit, n, 0.0);
+  S.recalibration = scored(*recal, recal_fit, n, 0.0, options.si_units);
   S.recalibration.delta_bic = bic0 - S.recalibration.bic;
   // Ranked best first; the fitted index of each ranked hypothesis kept for the greedy stage.
   std::vector<int> rank(to_fit.size());
@@ -468,6 +477,8 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
         for (const Candidate* c : chosen) ptot += static_cast<int>(c->parameters().size());
         ptot += static_cast<int>(lib[tries[k]]->parameters().size());
         if (significance(f2[k], chosen.size(), *lib[tries[k]], n, ptot) < options.min_significance) continue;
+      // At most one fitted parameter per two measured modes: the frequencies are the data to trust.
+      if (2 * ptot > std::max(2, measured.num_modes())) continue;
         int np = 0;
         double pen = 0;
         for (const Candidate* c : chosen) {
@@ -522,7 +533,7 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
     h.global = c.global();
     h.parameters = static_cast<int>(c.parameters().size());
     h.fitted = true;
-    h.values = c.physical(chosen_fit.theta[k], chosen_fit.stddev[k]);
+    h.values = values_of(c, chosen_fit.theta[k], chosen_fit.stddev[k], options.si_units);
     h.finding = c.finding(h.values);
     h.chi2 = chosen_fit.chi2;
     h.bic = chosen_bic;

@@ -49,7 +49,7 @@ DiscoverSpec::Expect parse_expect(const YAML::Node& n, const YamlCtx& ctx, bool 
 DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir) {
   ctx.require_map(n, "discover");
   ctx.only_keys(n, "discover", {"measured", "recordings", "identify", "truth", "modes", "min_mpc", "frequency_noise", "shape_noise",
-                                "kinds", "sensor_nodes", "suspension_nodes", "max_effects", "screen", "seeds", "expect"});
+                                "kinds", "sensor_nodes", "suspension_nodes", "max_effects", "screen", "seeds", "expect", "units"});
   DiscoverSpec d;
   const int sources = !!n["measured"] + !!n["recordings"] + !!n["truth"];
   if (sources != 1) ctx.fail(n, "discover: give exactly one of measured: FILE (modal data), recordings: [FILES] or truth: {model:, test:}");
@@ -114,6 +114,11 @@ DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model
   if (n["max_effects"]) o.max_effects = ctx.integer(n["max_effects"], "discover max_effects");
   if (n["screen"]) o.screen_fit = ctx.integer(n["screen"], "discover screen");
   if (n["seeds"]) d.seeds = ctx.integer(n["seeds"], "discover seeds");
+  if (n["units"]) {
+    const std::string u = ctx.string(n["units"], "discover units");
+    if (u != "si" && u != "other") ctx.fail(n["units"], "discover: units must be si (values labelled kg, N, m) or other (model units)");
+    o.si_units = u == "si";
+  }
   if (d.seeds < 1) ctx.fail(n["seeds"], "discover: seeds must be >= 1");
   if (d.seeds > 1 && !d.truth) ctx.fail(n["seeds"], "discover: seeds (a robustness study) needs a truth: model");
   std::string why;

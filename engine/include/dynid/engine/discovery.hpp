@@ -68,7 +68,8 @@ struct DiscoveryOptions {
   /// relative to each mode's largest entry). Identified data give their own frequency spread; these are floors.
   double frequency_noise = 1e-3, shape_noise = 5e-2;
   int screen_fit = 16;             ///< local candidates fitted in full after the linear screening
-  int max_effects = 3;             ///< greedy: at most this many effects combined
+  int max_effects = 3;             ///< greedy: at most this many effects combined (and at most one fitted
+                                   ///< parameter per two measured modes)
   /// Decisive evidence (BIC difference; 10 = "very strong" on the Kass-Raftery scale) for a finding and for each
   /// further effect; an alternative within `ambiguity` of the best makes the verdict inconclusive.
   double decisive = 10.0, ambiguity = 6.0;
@@ -81,6 +82,7 @@ struct DiscoveryOptions {
   std::vector<std::string> kinds;  ///< candidate kinds to consider (empty = all)
   std::vector<int> sensor_nodes;   ///< nodes carrying sensors (sensor mass loading); empty = the measured nodes
   std::vector<int> suspension_nodes;  ///< free-free tests: suspension points (empty = the two farthest nodes)
+  bool si_units = true;            ///< label reported values in SI (kg, N, m); false: "(model units)"
   bool IsValid(std::string* why) const;
 };
 
