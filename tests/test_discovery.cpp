@@ -3,7 +3,9 @@
 // identification and different discretizations is cases/discovery, run by tests/CMakeLists.txt.)
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
+#include <set>
 
 #include "dynid/engine/discovery.hpp"
 #include "dynid/engine/modal.hpp"
@@ -104,6 +106,141 @@ TEST(Discovery, ExactDataOfTheModelIsConsistent) {
   EXPECT_EQ(s.verdict, "consistent") << s.explanation;
   EXPECT_TRUE(s.findings.empty());
   EXPECT_LT(s.before.max_freq_error_pct, 1e-6);
+}
+
+}  // namespace
+}  // namespace dynid
+
+namespace dynid {
+namespace {
+
+// Eigenvalues of the analysis model with one candidate installed at theta (its own parameters).
+Eigen::VectorXd eigen_with(const Model& m, const Candidate& c, const Eigen::VectorXd& theta, int count) {
+  ParametricModel pm(m);
+  for (const CandidateParameter& q : c.parameters()) {
+    Parameter p;
+    p.name = q.name;
+    p.kind = ParameterKind::kCustom;
+    p.nominal = q.nominal;
+    p.lower = q.lower;
+    p.upper = q.upper;
+    pm.add(p);
+  }
+  for (CustomTerm& t : c.terms(m, 0)) pm.add_term(std::move(t));
+  SparseMatrix K, M;
+  pm.matrices(theta, &K, &M);
+  const Eigen::MatrixXd Kd(K), Md(M);
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(Kd, Md);
+  return es.eigenvalues().head(count);
+}
+
+// Every kind of candidate: eigenvalue derivatives from its terms' derivatives (complex step, analytic) against
+// central differences of its eigenvalues (step 1e-6: truncation ~1e-12, rounding ~1e-10 relative).
+TEST(Discovery, CandidateDerivativesMatchFiniteDifferences) {
+  Frame2DSpec s = portal();
+  s.divisions = 2;
+  const Model m = make_frame2d(s);
+  const ModalData meas = exact_modes(m, m, 4);
+  const auto lib = candidate_library(m, meas, DiscoveryOptions{});
+  std::set<std::string> seen;
+  for (const auto& c : lib) {
+    if (!seen.insert(c->kind()).second) continue;
+    const std::vector<CandidateParameter> ps = c->parameters();
+    Eigen::VectorXd th(static_cast<Eigen::Index>(ps.size()));
+    for (std::size_t q = 0; q < ps.size(); ++q) th[static_cast<Eigen::Index>(q)] = ps[q].nominal + 0.2;
+    ParametricModel pm(m);
+    for (const CandidateParameter& q : ps) {
+      Parameter p;
+      p.name = q.name;
+      p.kind = ParameterKind::kCustom;
+      p.nominal = q.nominal;
+      p.lower = q.lower;
+      p.upper = q.upper;
+      pm.add(p);
+    }
+    for (CustomTerm& t : c->terms(m, 0)) pm.add_term(std::move(t));
+    SparseMatrix K, M;
+    pm.matrices(th, &K, &M);
+    const Eigen::MatrixXd Kd(K), Md(M);
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(Kd, Md);
+    const Eigen::VectorXd lam = es.eigenvalues().head(4);
+    const Eigen::MatrixXd Phi = es.eigenvectors().leftCols(4);
+    const Eigen::MatrixXd S = pm.eigenvalue_sensitivities(th, lam, Phi);
+    for (Eigen::Index q = 0; q < th.size(); ++q) {
+      const double h = 1e-6;
+      Eigen::VectorXd tp = th, tm = th;
+      tp[q] += h;
+      tm[q] -= h;
+      const Eigen::VectorXd fd = (eigen_with(m, *c, tp, 4) - eigen_with(m, *c, tm, 4)) / (2 * h);
+      EXPECT_LT((fd - S.col(q)).norm(), 1e-5 * std::max(fd.norm(), 1e-6 * lam.norm())) << c->kind() << " parameter " << q;
+    }
+  }
+  EXPECT_GE(seen.size(), 9u);  // lumped mass, springs, release (support and joint), element E and rho, shear,
+                               // preload, distributed mass, sensor mass
+}
+
+// The Timoshenko candidate at alpha = 1/kappa against the element kernel's shear-deformable beam (an independent
+// implementation: the kernel builds the matrix from phi directly), and the preload candidate against elements
+// with an axial force: identical matrices, so identical eigenvalues (to rounding).
+TEST(Discovery, ShearAndPreloadCandidatesMatchTheElementKernels) {
+  BeamSpec b;
+  b.length = 2.0;
+  b.elements = 8;
+  b.material = steel();
+  b.section.name = "s";
+  b.section.A = 0.04;
+  b.section.Iz = 0.04 * 0.4 * 0.4 / 12;
+  b.support = BeamSupport::SimplySupported;
+  const Model m = make_beam(b);
+  const ModalData meas = exact_modes(m, m, 3);
+  BeamSpec bt = b;
+  bt.section.shear_factor = 5.0 / 6.0;
+  Model shear = make_beam(bt);
+  Model tmp = shear;  // rotary inertia on
+  Model t2;
+  for (const Node& n : tmp.nodes()) t2.add_node(n.id, n.x);
+  for (const Material& x : tmp.materials()) t2.add_material(x);
+  for (const Section& x : tmp.sections()) t2.add_section(x);
+  for (const Element& e : tmp.elements()) t2.add_element(e);
+  t2.restrain(1, dof_bit(Dof::UY));
+  t2.restrain(9, dof_bit(Dof::UY));
+  t2.set_rotary_inertia(true);
+  t2.finalize();
+  Model pre;
+  for (const Node& n : m.nodes()) pre.add_node(n.id, n.x);
+  for (const Material& x : m.materials()) pre.add_material(x);
+  for (const Section& x : m.sections()) pre.add_section(x);
+  for (Element e : m.elements()) {
+    e.axial_force = 2.0e6;
+    pre.add_element(e);
+  }
+  pre.restrain(1, dof_bit(Dof::UY));
+  pre.restrain(9, dof_bit(Dof::UY));
+  pre.finalize();
+  const auto lib = candidate_library(m, meas, DiscoveryOptions{});
+  int checked = 0;
+  for (const auto& c : lib) {
+    Eigen::VectorXd th(1);
+    const Model* ref = nullptr;
+    if (c->kind() == "shear_deformation") {
+      th[0] = 1.2;  // 1 / kappa
+      ref = &t2;
+    } else if (c->kind() == "axial_preload") {
+      // The candidate's unit is the Euler load of the group's extent: pi^2 E I / L^2.
+      th[0] = 2.0e6 / (M_PI * M_PI * b.material.E * b.section.Iz / (b.length * b.length));
+      ref = &pre;
+    } else {
+      continue;
+    }
+    EigenOptions eo;
+    eo.num_modes = 5;
+    eo.method = EigenOptions::Method::kDense;
+    const Eigen::VectorXd want = modal_analysis(*ref, eo).eigenvalues;
+    const Eigen::VectorXd got = eigen_with(m, *c, th, 5);
+    EXPECT_LT(((got - want).array() / want.array()).abs().maxCoeff(), 1e-10) << c->kind();
+    ++checked;
+  }
+  EXPECT_EQ(checked, 2);
 }
 
 }  // namespace
