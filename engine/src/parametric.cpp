@@ -184,7 +184,13 @@ void ParametricModel::build() const {
   }
   custom_of_param_.assign(params_.size(), {});
   for (std::size_t k = 0; k < custom_.size(); ++k) {
-    custom_[k].pos = positions(custom_[k].term.dofs);
+    try {
+      custom_[k].pos = positions(custom_[k].term.dofs);
+    } catch (const InternalError&) {
+      throw InputError("ParametricModel: custom term " + std::to_string(k) +
+                       " couples DOFs that the model's matrices do not (outside the sparsity pattern); a term may act "
+                       "on one element's DOFs or one node's DOFs");
+    }
     for (int p : custom_[k].term.params) custom_of_param_[p].push_back(static_cast<int>(k));
   }
   terms_of_param_.assign(params_.size(), {});
