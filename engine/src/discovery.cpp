@@ -153,20 +153,6 @@ bool near(const Model& m, const Site& a, const Site& b) {
   return false;
 }
 
-std::string site_words(const Site& s, bool global) {
-  if (global) return "";
-  std::string w;
-  if (!s.nodes.empty()) {
-    w += s.nodes.size() == 1 ? "node " : "nodes ";
-    for (std::size_t k = 0; k < s.nodes.size(); ++k) w += (k ? ", " : "") + std::to_string(s.nodes[k]);
-  }
-  if (!s.elements.empty()) {
-    w += std::string(w.empty() ? "" : ", ") + (s.elements.size() == 1 ? "element " : "elements ");
-    for (std::size_t k = 0; k < s.elements.size(); ++k) w += (k ? ", " : "") + std::to_string(s.elements[k]);
-  }
-  return w;
-}
-
 Localization locate(const Model& model, const ModalData& meas, const std::vector<int>& rows) {
   Localization L;
   L.dofs = meas.dofs;
