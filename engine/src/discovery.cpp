@@ -153,6 +153,9 @@ bool near(const Model& m, const Site& a, const Site& b) {
   return false;
 }
 
+// A share as a whole percentage: "27", "100".
+std::string pct(double share) { return std::to_string(static_cast<int>(std::lround(100.0 * share))); }
+
 Localization locate(const Model& model, const ModalData& meas, const std::vector<int>& rows) {
   Localization L;
   L.dofs = meas.dofs;
@@ -326,15 +329,21 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
     L.nature = best_m > best_k ? "mass" : "stiffness";
     std::string where;
     for (std::size_t k = 0; k < L.nodes.size() && k < 3; ++k)
-      where += (k ? ", " : "") + std::to_string(L.nodes[k].node) + " (" + fmt_value(100 * L.nodes[k].share, 2) + " %)";
+      where += (k ? ", " : "") + std::to_string(L.nodes[k].node) + " (" + pct(L.nodes[k].share) + " %)";
     const Eigen::Vector3d& ds = L.direction_share;
     const char* dir = ds[0] >= ds[1] && ds[0] >= ds[2] ? "x" : ds[1] >= ds[2] ? "y" : "z";
-    L.words = std::string("The residual forces are ") + (L.localized ? "localized" : "spread over the structure") + ": largest at node" +
-              (L.nodes.size() > 1 ? "s " : " ") + where + "; " + fmt_value(100 * L.concentration, 2) +
-              " % in the top fifth of the measured nodes, mostly in " + dir + ". The model is " +
+    L.words = L.nodes.size() < 3
+                  ? "Only " + std::to_string(L.nodes.size()) + " measured node" + (L.nodes.size() > 1 ? "s" : "") +
+                        ": the residual forces cannot say where. The model is "
+                  : std::string("The residual forces are ") + (L.localized ? "localized" : "spread over the structure") +
+                        ": largest at nodes " + where + "; " + pct(L.concentration) +
+                        " % in the top fifth of the measured nodes, mostly in " + dir + ". The model is ";
+    L.words += std::string() +
               (L.mean_frequency_error_pct > 0 ? "stiffer" : "softer") + " than the data on average (mean frequency error " +
               fmt_value(L.mean_frequency_error_pct, 3) + " %); the mismatch is " + L.nature + "-like (residual alignment with inertia forces " +
               fmt_value(L.mass_alignment, 2) + ").";
+    if (S.chi2_per_datum_before <= options.min_misfit)
+      L.words = "The model fits within the stated noise, so what follows describes noise, not a mismatch. " + L.words;
   }
 
   // ---- steps 2-3: fit the screened local candidates, every global one, and the recalibration ----
