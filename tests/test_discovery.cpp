@@ -117,16 +117,7 @@ namespace {
 // Eigenvalues of the analysis model with one candidate installed at theta (its own parameters).
 Eigen::VectorXd eigen_with(const Model& m, const Candidate& c, const Eigen::VectorXd& theta, int count) {
   ParametricModel pm(m);
-  for (const CandidateParameter& q : c.parameters()) {
-    Parameter p;
-    p.name = q.name;
-    p.kind = ParameterKind::kCustom;
-    p.nominal = q.nominal;
-    p.lower = q.lower;
-    p.upper = q.upper;
-    pm.add(p);
-  }
-  for (CustomTerm& t : c.terms(m, 0)) pm.add_term(std::move(t));
+  install_candidates(&pm, {&c});
   SparseMatrix K, M;
   pm.matrices(theta, &K, &M);
   const Eigen::MatrixXd Kd(K), Md(M);
@@ -149,20 +140,11 @@ TEST(Discovery, CandidateDerivativesMatchFiniteDifferences) {
     Eigen::VectorXd th(static_cast<Eigen::Index>(ps.size()));
     for (std::size_t q = 0; q < ps.size(); ++q) th[static_cast<Eigen::Index>(q)] = ps[q].nominal + 0.2;
     ParametricModel pm(m);
-    for (const CandidateParameter& q : ps) {
-      Parameter p;
-      p.name = q.name;
-      p.kind = ParameterKind::kCustom;
-      p.nominal = q.nominal;
-      p.lower = q.lower;
-      p.upper = q.upper;
-      pm.add(p);
-    }
-    for (CustomTerm& t : c->terms(m, 0)) pm.add_term(std::move(t));
+    install_candidates(&pm, {c.get()});
     SparseMatrix K, M;
     pm.matrices(th, &K, &M);
     const Eigen::MatrixXd Kd(K), Md(M);
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(Kd, Md);
+    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(Kd, Md);
     const Eigen::VectorXd lam = es.eigenvalues().head(4);
     const Eigen::MatrixXd Phi = es.eigenvectors().leftCols(4);
     const Eigen::MatrixXd S = pm.eigenvalue_sensitivities(th, lam, Phi);

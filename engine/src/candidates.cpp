@@ -157,6 +157,7 @@ class EndRelease : public Candidate {
     const auto types = m.element_dof_types(e);
     for (std::size_t k = 0; k < types.size(); ++k)
       if (types[k].first == m.element_nodes(e)[end] && types[k].second == d) i_ = static_cast<int>(k);
+    if (i_ >= 0) kii_ = member(m, e).K(i_, i_);
   }
   bool ok() const { return i_ >= 0; }
   std::string kind() const override { return support_ ? "flexible_support" : "semi_rigid_joint"; }
@@ -206,7 +207,6 @@ class EndRelease : public Candidate {
         if (dMd) *dMd = {M.imag() / h};
       }
     };
-    kii_ = mb.K(i_, i_);
     return {t};
   }
   std::vector<PhysicalValue> physical(const Eigen::VectorXd& th, const Eigen::VectorXd& sd) const override {
@@ -226,7 +226,7 @@ class EndRelease : public Candidate {
   Dof dof_;
   bool support_;
   int i_ = -1;
-  mutable double kii_ = 0;
+  double kii_ = 0;  // the member's stiffness on the released DOF: c = ctil / kii
 };
 
 // ---- element stiffness or mass change (damage, added material) ----------------------------------------------
@@ -272,23 +272,31 @@ std::vector<int> group_members(const Model& m, const std::string& g) {
   return out;
 }
 
-Site group_site(const Model& m, const std::vector<int>& els) {
-  Site s;
-  for (int e : els) s.elements.push_back(m.elements()[e].id);
-  return s;
-}
+// A global candidate acting on a set of elements (all members, or a group): its site is those elements.
+class OnElements : public Candidate {
+ public:
+  OnElements(const Model& m, std::vector<int> els) : els_(std::move(els)) {
+    for (int e : els_) site_.elements.push_back(m.elements()[e].id);
+  }
+  Site site() const override { return site_; }
+  bool global() const override { return true; }
+
+ protected:
+  std::vector<int> els_;
+
+ private:
+  Site site_;
+};
 
 // ---- shear deformation and rotary inertia (Timoshenko) ----------------------------------------------------------
 // Per member (plane bending): K_b(alpha) = (K_b + alpha phi0 EI/L d d^T) / (1 + alpha phi0), phi0 = 12 EI/(G A L^2),
 // d = e_t1 - e_t2 on the rotations; alpha = 1/kappa (0 = Euler-Bernoulli). The rotary inertia rho I (int N'^T N')
 // is added with it (Timoshenko theory has both).
-class ShearDeformation : public Candidate {
+class ShearDeformation : public OnElements {
  public:
-  ShearDeformation(const Model& m, std::vector<int> els) : els_(std::move(els)), site_(group_site(m, els_)) {}
+  ShearDeformation(const Model& m, std::vector<int> els) : OnElements(m, std::move(els)) {}
   std::string kind() const override { return "shear_deformation"; }
   std::string description() const override { return "shear deformation and rotary inertia (Timoshenko beams) in all members"; }
-  Site site() const override { return site_; }
-  bool global() const override { return true; }
   std::vector<CandidateParameter> parameters() const override { return {{"1/kappa", 0.0, 0.0, 20.0}}; }
   std::vector<CustomTerm> terms(const Model& m, int first) const override {
     std::vector<CustomTerm> out;
@@ -323,17 +331,13 @@ class ShearDeformation : public Candidate {
   std::string finding(const std::vector<PhysicalValue>& v) const override {
     return "the members deform in shear (Timoshenko, not Euler-Bernoulli beams): shear coefficient kappa = " + with_std(v[0]);
   }
-
- private:
-  std::vector<int> els_;
-  Site site_;
 };
 
 // ---- axial preload (geometric stiffness) --------------------------------------------------------------------
-class AxialPreload : public Candidate {
+class AxialPreload : public OnElements {
  public:
   AxialPreload(const Model& m, std::string group, std::vector<int> els)
-      : group_(std::move(group)), els_(std::move(els)), site_(group_site(m, els_)) {
+      : OnElements(m, std::move(els)), group_(std::move(group)) {
     // Reference force: the Euler load pi^2 EI / Lg^2 of the group's extent Lg.
     double EI = 0;
     Eigen::Vector3d a = Eigen::Vector3d::Constant(1e300), b = -a;
@@ -350,8 +354,6 @@ class AxialPreload : public Candidate {
   }
   std::string kind() const override { return "axial_preload"; }
   std::string description() const override { return "axial preload (geometric stiffness) in " + group_words(group_); }
-  Site site() const override { return site_; }
-  bool global() const override { return true; }
   std::vector<CandidateParameter> parameters() const override { return {{"force", 0.0, -0.9, 200.0}}; }
   std::vector<CustomTerm> terms(const Model& m, int first) const override {
     std::vector<CustomTerm> out;
@@ -372,16 +374,14 @@ class AxialPreload : public Candidate {
 
  private:
   std::string group_;
-  std::vector<int> els_;
-  Site site_;
   double pref_ = 1;
 };
 
 // ---- distributed non-structural mass on a group ---------------------------------------------------------------
-class NonStructuralMass : public Candidate {
+class NonStructuralMass : public OnElements {
  public:
   NonStructuralMass(const Model& m, std::string group, std::vector<int> els)
-      : group_(std::move(group)), els_(std::move(els)), site_(group_site(m, els_)) {
+      : OnElements(m, std::move(els)), group_(std::move(group)) {
     double len = 0;
     for (int e : els_) {
       const Member mb = member(m, e);
@@ -392,8 +392,6 @@ class NonStructuralMass : public Candidate {
   }
   std::string kind() const override { return "distributed_mass"; }
   std::string description() const override { return "distributed non-structural mass on " + group_words(group_); }
-  Site site() const override { return site_; }
-  bool global() const override { return true; }
   std::vector<CandidateParameter> parameters() const override { return {{"fraction", 0.0, 0.0, 5.0}}; }
   std::vector<CustomTerm> terms(const Model& m, int first) const override {
     std::vector<CustomTerm> out;
@@ -413,8 +411,6 @@ class NonStructuralMass : public Candidate {
 
  private:
   std::string group_;
-  std::vector<int> els_;
-  Site site_;
   double mass_ = 0, per_length_ = 0;
 };
 
@@ -464,13 +460,11 @@ class NodeSet : public Candidate {
 };
 
 // ---- the classic alternative: recalibrate E and rho globally -------------------------------------------------
-class Recalibration : public Candidate {
+class Recalibration : public OnElements {
  public:
-  Recalibration(const Model& m, std::vector<int> els) : els_(std::move(els)), site_(group_site(m, els_)) {}
+  Recalibration(const Model& m, std::vector<int> els) : OnElements(m, std::move(els)) {}
   std::string kind() const override { return "global_recalibration"; }
   std::string description() const override { return "recalibrate the stiffness (E) and mass (rho) of the whole model"; }
-  Site site() const override { return site_; }
-  bool global() const override { return true; }
   std::vector<CandidateParameter> parameters() const override { return {{"E change", 0.0, -0.9, 3.0}, {"rho change", 0.0, -0.9, 3.0}}; }
   std::vector<CustomTerm> terms(const Model& m, int first) const override {
     std::vector<CustomTerm> out;
@@ -487,10 +481,6 @@ class Recalibration : public Candidate {
   std::string finding(const std::vector<PhysicalValue>& v) const override {
     return "the members' E and rho are off: E x " + fmt_value(v[0].value, 4) + ", rho x " + fmt_value(v[1].value, 4);
   }
-
- private:
-  std::vector<int> els_;
-  Site site_;
 };
 
 }  // namespace

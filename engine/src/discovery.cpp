@@ -33,6 +33,25 @@ std::vector<std::unique_ptr<Candidate>> candidate_library(const Model& model, co
   return internal::library(model, measured, options);
 }
 
+std::vector<int> install_candidates(ParametricModel* pm, const std::vector<const Candidate*>& set) {
+  std::vector<int> first;
+  for (const Candidate* c : set) {
+    first.push_back(pm->num_parameters());
+    for (const CandidateParameter& q : c->parameters()) {
+      Parameter p;
+      p.name = c->kind() + "." + q.name;
+      p.kind = ParameterKind::kCustom;
+      p.nominal = q.nominal;
+      p.lower = q.lower;
+      p.upper = q.upper;
+      pm->add(p);
+    }
+  }
+  for (std::size_t k = 0; k < set.size(); ++k)
+    for (CustomTerm& t : set[k]->terms(pm->model(), first[k])) pm->add_term(std::move(t));
+  return first;
+}
+
 namespace {
 
 using internal::fmt_value;
@@ -46,20 +65,7 @@ struct Installed {
 Installed install(const Model& model, const std::vector<const Candidate*>& set) {
   Installed in;
   in.pm = std::make_unique<ParametricModel>(model);
-  for (const Candidate* c : set) {
-    in.first.push_back(in.pm->num_parameters());
-    for (const CandidateParameter& q : c->parameters()) {
-      Parameter p;
-      p.name = c->kind() + "." + q.name;
-      p.kind = ParameterKind::kCustom;
-      p.nominal = q.nominal;
-      p.lower = q.lower;
-      p.upper = q.upper;
-      in.pm->add(p);
-    }
-  }
-  for (std::size_t k = 0; k < set.size(); ++k)
-    for (CustomTerm& t : set[k]->terms(model, in.first[k])) in.pm->add_term(std::move(t));
+  in.first = install_candidates(in.pm.get(), set);
   return in;
 }
 
@@ -218,7 +224,8 @@ std::vector<PhysicalValue> values_of(const Candidate& c, const Eigen::VectorXd& 
   return v;
 }
 
-ScoredHypothesis scored(const Candidate& c, const SetFit& f, int n, double penalty, bool si) {
+// Candidate `k` of a fitted set, scored by the set's BIC `score` (+inf if the fit failed).
+ScoredHypothesis scored(const Candidate& c, const SetFit& f, std::size_t k, double score, bool si) {
   ScoredHypothesis h;
   h.kind = c.kind();
   h.description = c.description();
@@ -226,13 +233,11 @@ ScoredHypothesis scored(const Candidate& c, const SetFit& f, int n, double penal
   h.global = c.global();
   h.parameters = static_cast<int>(c.parameters().size());
   h.fitted = f.ok;
-  if (!f.ok) {
-    h.bic = std::numeric_limits<double>::infinity();
-    return h;
-  }
+  h.bic = std::numeric_limits<double>::infinity();
+  if (!f.ok) return h;
   h.chi2 = f.chi2;
-  h.bic = bic(f.chi2, n, h.parameters, penalty);
-  h.values = values_of(c, f.theta[0], f.stddev[0], si);
+  h.bic = score;
+  h.values = values_of(c, f.theta[k], f.stddev[k], si);
   h.finding = c.finding(h.values);
   h.max_freq_error_pct = f.quality.max_freq_error_pct;
   h.mean_mac = f.quality.mean_mac;
@@ -367,13 +372,14 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   }
   for (std::size_t k = 0; k < to_fit.size(); ++k) {
     S.eigen_solves += fits[k].evaluations;
-    ScoredHypothesis h = scored(*lib[to_fit[k]], fits[k], n, penalty(*lib[to_fit[k]]), options.si_units);
+    const Candidate& c = *lib[to_fit[k]];
+    ScoredHypothesis h = scored(c, fits[k], 0, bic(fits[k].chi2, n, static_cast<int>(c.parameters().size()), penalty(c)), options.si_units);
     h.screening = screening[to_fit[k]];
     h.delta_bic = bic0 - h.bic;
     S.candidates.push_back(std::move(h));
   }
   S.eigen_solves += recal_fit.evaluations;
-  S.recalibration = scored(*recal, recal_fit, n, 0.0, options.si_units);
+  S.recalibration = scored(*recal, recal_fit, 0, bic(recal_fit.chi2, n, static_cast<int>(recal->parameters().size()), 0.0), options.si_units);
   S.recalibration.delta_bic = bic0 - S.recalibration.bic;
   // Ranked best first; the fitted index of each ranked hypothesis kept for the greedy stage.
   std::vector<int> rank(to_fit.size());
@@ -520,22 +526,8 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
 
   // ---- findings ----
   for (std::size_t k = 0; k < chosen.size(); ++k) {
-    ScoredHypothesis h;
-    const Candidate& c = *chosen[k];
-    h.kind = c.kind();
-    h.description = c.description();
-    h.site = c.site();
-    h.global = c.global();
-    h.parameters = static_cast<int>(c.parameters().size());
-    h.fitted = true;
-    h.values = values_of(c, chosen_fit.theta[k], chosen_fit.stddev[k], options.si_units);
-    h.finding = c.finding(h.values);
-    h.chi2 = chosen_fit.chi2;
-    h.bic = chosen_bic;
+    ScoredHypothesis h = scored(*chosen[k], chosen_fit, k, chosen_bic, options.si_units);
     h.delta_bic = bic0 - chosen_bic;
-    h.max_freq_error_pct = chosen_fit.quality.max_freq_error_pct;
-    h.mean_mac = chosen_fit.quality.mean_mac;
-    h.at_bound = chosen_fit.at_bound;
     S.findings.push_back(std::move(h));
   }
   S.after = chosen_fit.quality;

@@ -150,6 +150,10 @@ struct DiscoverySummary {
 std::vector<std::unique_ptr<Candidate>> candidate_library(const Model& model, const ModalData& measured,
                                                           const DiscoveryOptions& options);
 
+/// Adds the candidates' parameters (kCustom, with their bounds) and terms to `pm`, in order; returns the index of
+/// each candidate's first parameter. For host codes that fit or evaluate candidates themselves.
+std::vector<int> install_candidates(ParametricModel* pm, const std::vector<const Candidate*>& set);
+
 /// Runs the four steps. `extra` candidates (a host code's own) are considered with the library's.
 /// Throws InputError for data that does not fit the model or invalid options.
 DiscoverySummary discover(const Model& model, const ModalData& measured, const DiscoveryOptions& options,
