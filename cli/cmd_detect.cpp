@@ -123,7 +123,7 @@ plot::Figure summary_figure(const Case& c, const Model& model, const DetectSumma
 int run_detect(const DetectArgs& a, const GlobalOptions& g) {
   set_threads(g.threads);
   const Case c = load_case(a.case_path);
-  if (!c.detect) throw InputError(c.path + ": the case has no detect: section (see docs/case-file.md)");
+  require_section(c, c.detect.has_value(), "detect");
   const DetectSpec& d = *c.detect;
   const Model& model = c.model;
   Progress progress(!g.quiet);

@@ -2,7 +2,6 @@
 #include <fmt/core.h>
 
 #include <cmath>
-#include <filesystem>
 #include <memory>
 
 #include "commands.hpp"
@@ -11,7 +10,6 @@
 #include "dynid/mesh/error.hpp"
 #include "progress.hpp"
 
-namespace fs = std::filesystem;
 
 namespace dynid::cli {
 
@@ -33,11 +31,7 @@ void print_summary(const Case& c, const DiscoveryData& d, const DiscoverySummary
   const int show = std::min<int>(12, static_cast<int>(s.candidates.size()));
   for (int k = 0; k < show; ++k) {
     const ScoredHypothesis& h = s.candidates[k];
-    std::string where = h.global ? "global" : "";
-    if (!h.global) {
-      for (int n : h.site.nodes) where += (where.empty() ? "n" : ",n") + std::to_string(n);
-      for (int e : h.site.elements) where += (where.empty() ? "e" : ",e") + std::to_string(e);
-    }
+    std::string where = h.global ? "global" : site_label(h.site, ",");
     if (where.size() > 28) where = where.substr(0, 25) + "...";
     fmt::print("       {:>4}  {:<22} {:<28} {:>9.1f} {:>9.3f} {:>8.5f}{}\n", k + 1, h.kind, where, h.delta_bic, h.max_freq_error_pct, h.mean_mac,
                h.at_bound ? "  (at a bound)" : "");
@@ -55,16 +49,13 @@ void print_summary(const Case& c, const DiscoveryData& d, const DiscoverySummary
 int run_discover(const DiscoverArgs& a, const GlobalOptions& g) {
   set_threads(g.threads);
   const Case c = load_case(a.case_path);
-  if (!c.discover) throw InputError(c.path + ": the case has no discover: section (see docs/case-file.md)");
+  require_section(c, c.discover.has_value(), "discover");
   const DiscoverSpec& spec = *c.discover;
   const int seeds = a.seeds > 0 ? a.seeds : spec.seeds;
   if (seeds > 1 && !spec.truth) throw InputError("discover: --seeds needs a case with a truth: model (a concealed-data study)");
-  const std::string stem = (fs::path(c.dir) / c.name).string();
   const std::string json = a.json.empty() ? c.name + "-discover.json" : a.json;
   const std::string png = a.plot.empty() ? c.name + "-discover.png" : a.plot;
-  for (const std::string& p : {json, png})
-    if (!a.force && fs::exists(p)) throw InputError(p + ": file exists; pass --force to overwrite it");
-  (void)stem;
+  refuse_existing({json, png}, a.force);
   Progress progress(!g.quiet);
   progress.update(spec.truth ? "virtual test of the truth model and identification" : "measured data", -1);
   DiscoveryData d = discovery_data(c, 0);
@@ -89,25 +80,27 @@ int run_discover(const DiscoverArgs& a, const GlobalOptions& g) {
   if (spec.expect) check = std::make_unique<ExpectCheck>(check_expectation(*spec.expect, s));
   nlohmann::ordered_json j = discovery_json(c, d, s, check.get());
 
-  // Robustness: the same case over further noise seeds of the truth test.
+  // Robustness: the same case over further noise seeds of the truth test (seed offset 0 is the run above).
   if (seeds > 1) {
-    int named = check && check->ok() ? 1 : 0, consistent = s.verdict == "consistent";
-    std::vector<double> errs = {check ? check->parameter_error : NAN};
+    int named = 0, consistent = 0;
+    double worst = 0;
     nlohmann::ordered_json runs = nlohmann::ordered_json::array();
-    runs.push_back({{"seed_offset", 0}, {"verdict", s.verdict}, {"first", s.findings.empty() ? "" : s.findings[0].kind}, {"ok", check && check->ok()}});
-    for (int k = 1; k < seeds; ++k) {
-      progress.update("robustness: seed " + std::to_string(k + 1) + " of " + std::to_string(seeds), -1);
-      const DiscoveryData dk = discovery_data(c, k);
-      const DiscoverySummary sk = discover(c.model, dk.measured, spec.options);
-      const bool ok = spec.expect && check_expectation(*spec.expect, sk).ok();
+    auto record = [&](int k, const DiscoverySummary& sk) {
+      bool ok = false;
+      if (spec.expect) {
+        const ExpectCheck ck = check_expectation(*spec.expect, sk);
+        ok = ck.ok();
+        if (std::isfinite(ck.parameter_error)) worst = std::max(worst, ck.parameter_error);
+      }
       named += ok;
       consistent += sk.verdict == "consistent";
-      if (spec.expect) errs.push_back(check_expectation(*spec.expect, sk).parameter_error);
       runs.push_back({{"seed_offset", k}, {"verdict", sk.verdict}, {"first", sk.findings.empty() ? "" : sk.findings[0].kind}, {"ok", ok}});
+    };
+    record(0, s);
+    for (int k = 1; k < seeds; ++k) {
+      progress.update("robustness: seed " + std::to_string(k + 1) + " of " + std::to_string(seeds), -1);
+      record(k, discover(c.model, discovery_data(c, k).measured, spec.options));
     }
-    double worst = 0;
-    for (double e : errs)
-      if (std::isfinite(e)) worst = std::max(worst, e);
     j["robustness"] = {{"seeds", seeds}, {"as_expected", named}, {"rate", static_cast<double>(named) / seeds},
                        {"consistent", consistent}, {"worst_parameter_error", worst}, {"runs", runs}};
   }

@@ -167,8 +167,7 @@ int run_identify(const IdentifyArgs& a, const GlobalOptions& g) {
   const std::string png = a.plot.empty() ? stem + "-stabilization.png" : a.plot;
   const ModalData md = s.modal_data("dynid identify " + method);
   // Refuse before writing anything if an output exists (no partial results).
-  for (const std::string& p : {json, uff, png})
-    if (!a.force && fs::exists(p)) throw InputError(p + ": file exists; pass --force to overwrite it");
+  refuse_existing({json, uff, png}, a.force);
   if (md.frequencies_hz.size() > 0) write_uff55(uff, md, a.force);
   write_file_atomic(json, identification_json(s).dump(1) + "\n", a.force);
   plot::save(stabilization_figure(s, "dynid identify: " + fs::path(a.files[0]).filename().string() + (a.files.size() > 1 ? " ..." : "")), png, a.force);
@@ -197,18 +196,11 @@ struct SimulateArgs {
 int run_simulate(const SimulateArgs& a, const GlobalOptions& g) {
   set_threads(g.threads);
   const Case c = load_case(a.case_path);
-  if (!c.test) throw InputError(c.path + ": the case has no test: section (see docs/case-file.md)");
+  require_section(c, c.test.has_value(), "test");
   const TestSpec& t = *c.test;
   Progress progress(!g.quiet);
-  progress.update("modes", -1);
-  const double nyquist = t.options.sample_rate_hz / 2;
-  EigenOptions eo = c.analysis.eigen_options();
-  eo.band_lo = 0;
-  eo.band_hi = hz_to_eigenvalue(t.max_frequency_hz > 0 ? t.max_frequency_hz : 1.2 * nyquist);
-  const ModalResult modes = modal_analysis(c.model, eo);
-  if (!modes.ok()) throw NumericalError("modal analysis failed: " + modes.summary.message);
-  progress.update("simulating", -1);
-  const VirtualTest vt = simulate_test(c.model, modes, t.options);
+  progress.update("modes and simulation", -1);
+  const VirtualTest vt = run_test_spec(c.model, t, c.analysis.eigen_options(), 0, "modal analysis ");
   progress.done();
   std::string out = !a.output.empty() ? a.output : !t.output.empty() ? t.output : (fs::path(c.dir) / (c.name + "-test.uff")).string();
   // One file per recording (a roving hammer gives one per hit location: their channel sets differ).

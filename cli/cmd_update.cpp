@@ -121,7 +121,7 @@ plot::Figure update_figure(const Case& c, const ParametricModel& pm, const Updat
 int run_update(const UpdateArgs& a, const GlobalOptions& g) {
   set_threads(g.threads);
   const Case c = load_case(a.case_path);
-  if (!c.update) throw InputError(c.path + ": the case has no update: section (see docs/case-file.md)");
+  require_section(c, c.update.has_value(), "update");
   const UpdateSpec& u = *c.update;
   Progress progress(!g.quiet);
   progress.update("measured data", -1);

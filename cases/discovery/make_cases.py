@@ -356,17 +356,24 @@ discover:
     write(folder, "case.yaml", case)
 
 
+def beam_header(material, props, width, depth):
+    return f"""model:
+  element: beam2d
+  materials:
+    {material}: {{{props}}}
+  sections:
+    s: {{rectangle: {{width: {width}, depth: {depth}}}}}
+  defaults: {{material: {material}}}
+"""
+
+
+STEEL = "E: 2.1e11, rho: 7850, nu: 0.3"
+
+
 def beams():
     # 7. sensor mass loading: a light aluminium cantilever (600 x 25 x 3 mm, 0.12 kg) carrying five 6 g
     #    accelerometers (with their rotary inertia in the truth).
-    hdr = """model:
-  element: beam2d
-  materials:
-    alu: {E: 7.0e10, rho: 2700, nu: 0.33}
-  sections:
-    s: {rectangle: {width: 0.025, depth: 0.003}}
-  defaults: {material: alu}
-"""
+    hdr = beam_header("alu", "E: 7.0e10, rho: 2700, nu: 0.33", 0.025, 0.003)
     a = beam_mesh(0.6, 10, "cantilever")
     t = beam_mesh(0.6, 10, "cantilever", extra_sub=2)
     sensors_n = [3, 5, 7, 9, 11]
@@ -377,14 +384,7 @@ def beams():
 
     # 8. shear deformation: a deep steel beam (2 m span, 400 x 100 mm, L/h = 5), simply supported; truth in
     #    Timoshenko elements (kappa = 5/6, rotary inertia), four times finer.
-    hdr = """model:
-  element: beam2d
-  materials:
-    steel: {E: 2.1e11, rho: 7850, nu: 0.3}
-  sections:
-    s: {rectangle: {width: 0.1, depth: 0.4}}
-  defaults: {material: steel}
-"""
+    hdr = beam_header("steel", STEEL, 0.1, 0.4)
     hdr_t = hdr.replace("s: {rectangle: {width: 0.1, depth: 0.4}}", "s: {rectangle: {width: 0.1, depth: 0.4}, shear_factor: 0.8333333333}").replace(
         "  element: beam2d\n", "  element: beam2d\n  rotary_inertia: true\n")
     a = beam_mesh(2.0, 20, "simply_supported")
@@ -394,14 +394,7 @@ def beams():
               "{kind: shear_deformation, parameter: shear coefficient kappa, value: 0.8333}", 22, "Timoshenko, kappa = 5/6")
 
     # 9. axial preload: a tensioned steel strip (2 m, 40 x 5 mm), pinned at both ends, 1 kN tension.
-    hdr = """model:
-  element: beam2d
-  materials:
-    steel: {E: 2.1e11, rho: 7850, nu: 0.3}
-  sections:
-    s: {rectangle: {width: 0.04, depth: 0.005}}
-  defaults: {material: steel}
-"""
+    hdr = beam_header("steel", STEEL, 0.04, 0.005)
     a = beam_mesh(2.0, 20, "simply_supported")
     t = beam_mesh(2.0, 20, "simply_supported", extra_sub=2)
     for e in t.elements:

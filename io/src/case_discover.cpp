@@ -164,7 +164,7 @@ ModalData keep_modes(ModalData m, const DiscoverSpec& d, std::vector<std::string
 }  // namespace
 
 DiscoveryData discovery_data(const Case& c, int seed_offset) {
-  if (!c.discover) throw InputError(c.path + ": the case has no discover: section (see docs/case-file.md)");
+  require_section(c, c.discover.has_value(), "discover");
   const DiscoverSpec& d = *c.discover;
   DiscoveryData out;
   if (!d.measured_file.empty()) {
@@ -175,18 +175,11 @@ DiscoveryData discovery_data(const Case& c, int seed_offset) {
   } else {
     std::vector<Recording> recs;
     if (d.truth) {
-      const TestSpec& t = *d.truth_test;
-      VirtualTestOptions vo = t.options;
-      vo.seed += static_cast<std::uint64_t>(seed_offset);
-      EigenOptions eo;
-      eo.band_lo = 0;
-      eo.band_hi = hz_to_eigenvalue(t.max_frequency_hz > 0 ? t.max_frequency_hz : 0.6 * vo.sample_rate_hz);
-      const ModalResult modes = modal_analysis(*d.truth, eo);
-      if (!modes.ok()) throw NumericalError(c.path + ": modal analysis of the truth model failed: " + modes.summary.message);
-      VirtualTest vt = simulate_test(*d.truth, modes, vo);
+      VirtualTest vt = run_test_spec(*d.truth, *d.truth_test, EigenOptions{}, static_cast<std::uint64_t>(seed_offset),
+                                     c.path + ": modal analysis of the truth model ");
       recs = std::move(vt.recordings);
       out.truth_modes = std::move(vt.modes);
-      out.source = "virtual test of the truth model (seed " + std::to_string(vo.seed) + ")";
+      out.source = "virtual test of the truth model (seed " + std::to_string(d.truth_test->options.seed + static_cast<std::uint64_t>(seed_offset)) + ")";
     } else {
       for (const std::string& f : d.recordings) {
         TestData td = read_test_data(f);

@@ -218,6 +218,10 @@ DetectSpec parse_detect(const YAML::Node& n, const YamlCtx& ctx, const Model& mo
 
 }  // namespace
 
+void require_section(const Case& c, bool present, const std::string& section) {
+  if (!present) throw InputError(c.path + ": the case has no " + section + ": section (see docs/case-file.md)");
+}
+
 std::string resolve_case_path(const std::string& path) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) {
@@ -276,7 +280,7 @@ ModalData simulate(const Model& m, const std::vector<MeasuredDof>& dofs, int cou
 }  // namespace
 
 ModalData detect_changed_data(const Case& c, Model* changed) {
-  if (!c.detect) throw InputError(c.path + ": the case has no detect: section (see docs/case-file.md)");
+  require_section(c, c.detect.has_value(), "detect");
   const DetectSpec& d = *c.detect;
   if (!d.measured_file.empty()) return read_modal_data(d.measured_file);
   *changed = changed_model(c.model, d.changes);
@@ -284,7 +288,7 @@ ModalData detect_changed_data(const Case& c, Model* changed) {
 }
 
 ModalData update_measured_data(const Case& c) {
-  if (!c.update) throw InputError(c.path + ": the case has no update: section (see docs/case-file.md)");
+  require_section(c, c.update.has_value(), "update");
   const UpdateSpec& u = *c.update;
   ModalData m = !u.measured_file.empty()
                     ? read_modal_data(u.measured_file)

@@ -112,3 +112,18 @@ TestSpec parse_test(const YAML::Node& n, const YamlCtx& ctx, const Model& model,
 }
 
 }  // namespace dynid::internal
+
+namespace dynid {
+
+VirtualTest run_test_spec(const Model& model, const TestSpec& t, EigenOptions eo, std::uint64_t seed_offset,
+                          const std::string& what) {
+  VirtualTestOptions vo = t.options;
+  vo.seed += seed_offset;
+  eo.band_lo = 0;
+  eo.band_hi = hz_to_eigenvalue(t.max_frequency_hz > 0 ? t.max_frequency_hz : 1.2 * vo.sample_rate_hz / 2);
+  const ModalResult modes = modal_analysis(model, eo);
+  if (!modes.ok()) throw NumericalError(what + "failed: " + modes.summary.message);
+  return simulate_test(model, modes, vo);
+}
+
+}  // namespace dynid

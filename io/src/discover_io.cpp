@@ -92,6 +92,13 @@ nlohmann::ordered_json quality_json(const FitQuality& q) {
 
 }  // namespace
 
+std::string site_label(const Site& s, const std::string& sep) {
+  std::string w;
+  for (int n : s.nodes) w += (w.empty() ? "n" : sep + "n") + std::to_string(n);
+  for (int e : s.elements) w += (w.empty() ? "e" : sep + "e") + std::to_string(e);
+  return w;
+}
+
 ExpectCheck check_expectation(const DiscoverSpec::Expect& e, const DiscoverySummary& s) {
   ExpectCheck c;
   c.verdict = s.verdict == e.verdict;
@@ -300,13 +307,8 @@ plot::Figure discovery_figure(const Case& c, const DiscoverySummary& s) {
     t.x.push_back(k + 1);
     t.y.push_back(h.fitted ? h.delta_bic : 0.0);
     lo = std::min(lo, h.fitted ? h.delta_bic : 0.0);
-    std::string lab = short_kind(h.kind);
-    if (!h.global) {
-      for (int n : h.site.nodes) lab += " n" + std::to_string(n);
-      for (int e : h.site.elements) lab += " e" + std::to_string(e);
-    } else {
-      lab += " [" + std::to_string(h.site.elements.size()) + " el]";
-    }
+    const std::string lab = short_kind(h.kind) + " " +
+                            (h.global ? "[" + std::to_string(h.site.elements.size()) + " el]" : site_label(h.site, " "));
     rank.xticks.push_back({static_cast<double>(k + 1), lab});
   }
   recal.x.push_back(show + 1);

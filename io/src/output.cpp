@@ -23,6 +23,12 @@ std::string internal::read_file_bytes(const std::string& path) {
   return ss.str();
 }
 
+void refuse_existing(std::initializer_list<std::string> paths, bool overwrite) {
+  std::error_code ec;
+  for (const std::string& p : paths)
+    if (!overwrite && fs::exists(p, ec)) throw InputError(p + ": file exists; pass --force to overwrite it");
+}
+
 void write_file_atomic(const std::string& path, const std::string& content, bool overwrite) {
   std::error_code ec;
   if (!overwrite && fs::exists(path, ec))

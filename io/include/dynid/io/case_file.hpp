@@ -4,6 +4,7 @@
 
 #include <limits>
 #include <memory>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -118,6 +119,15 @@ Case parse_case(const std::string& text, const std::string& name, const std::str
 ModalData detect_changed_data(const Case& c, Model* changed);
 /// The measured data of an update: case: from its file, or the simulated target; the first `modes` modes.
 ModalData update_measured_data(const Case& c);
+
+/// The virtual test `t` describes, run on `model`: its modes up to t.max_frequency_hz (default 1.2 x Nyquist) with
+/// the solver settings `eo`, then simulate_test with the noise seed shifted by `seed_offset`. Throws
+/// NumericalError("<what>failed: ...") if the modal analysis fails.
+VirtualTest run_test_spec(const Model& model, const TestSpec& t, EigenOptions eo, std::uint64_t seed_offset,
+                          const std::string& what);
+
+/// Throws InputError("<case>: the case has no <section>: section (see docs/case-file.md)") unless `present`.
+void require_section(const Case& c, bool present, const std::string& section);
 
 /// Resolves a CASE argument (file or folder) to the case file path; throws InputError if there is none.
 std::string resolve_case_path(const std::string& path);

@@ -35,6 +35,9 @@ struct ExpectCheck {
 };
 ExpectCheck check_expectation(const DiscoverSpec::Expect& e, const DiscoverySummary& s);
 
+/// A site in short form: "n4" + sep + "e37".
+std::string site_label(const Site& s, const std::string& sep);
+
 nlohmann::ordered_json discovery_json(const Case& c, const DiscoveryData& d, const DiscoverySummary& s,
                                       const ExpectCheck* check);
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <initializer_list>
 #include <string>
 
 #include "dynid/engine/modal.hpp"
@@ -13,6 +14,10 @@ namespace dynid {
 /// run never leaves a half-written file. Refuses to replace an existing file unless `overwrite` is set.
 /// Throws InputError naming the path.
 void write_file_atomic(const std::string& path, const std::string& content, bool overwrite);
+
+/// Checks every output of a command before any is written (no partial results): throws InputError for the first
+/// path that exists, unless `overwrite`.
+void refuse_existing(std::initializer_list<std::string> paths, bool overwrite);
 
 /// The modal results as JSON: {"case", "dofs", "nonzeros", "modes": [{"index", "frequency_hz", "eigenvalue",
 /// "rigid_body", "description"?, "residual"}], "solver": {...}}. See docs/results-json.md.
