@@ -50,6 +50,11 @@ std::string trim(const std::string& s) {
   if (a == std::string::npos) return "";
   return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
 }
+/// The folder holding `path` ("." for a bare file name), against which its *INCLUDEs resolve.
+std::string folder_of(const std::string& path) {
+  const fs::path parent = fs::path(path).parent_path();
+  return parent.empty() ? "." : parent.string();
+}
 std::vector<std::string> split(const std::string& s) {
   std::vector<std::string> f;
   std::stringstream ss(s);
@@ -80,24 +85,27 @@ struct Card {
 
 class AbaqusReader {
  public:
-  explicit AbaqusReader(const std::string& path) {
-    out_.file = path;
+  explicit AbaqusReader(const std::string& name) {
+    out_.file = name;
     out_.names_ignore_case = true;
   }
 
-  MeshData read() {
+  /// `bytes` is the file named `name`; its *INCLUDEs are read from `include_dir` ("": not allowed).
+  MeshData read(const std::string& bytes, const std::string& include_dir) {
     std::vector<Line> lines;
-    load(out_.file, 0, &lines);
+    load(bytes, out_.file, include_dir, 0, &lines);
     for (const Card& c : cards(lines)) card(c);
     finish();
     return std::move(out_);
   }
 
  private:
-  /// Reads a file's lines, expanding *INCLUDE, dropping comments and blank lines, joining continuations.
-  void load(const std::string& path, int depth, std::vector<Line>* lines) {
+  /// Splits a file's bytes into lines, expanding *INCLUDE (files in `dir`; "": none allowed), dropping comments
+  /// and blank lines, joining continuations.
+  void load(const std::string& bytes, const std::string& path, const std::string& dir, int depth,
+            std::vector<Line>* lines) {
     if (depth > 10) throw InputError(path + ": *INCLUDE nested more than 10 deep (a cycle?)");
-    std::istringstream in(internal::read_file_bytes(path));
+    std::istringstream in(bytes);
     int n = 0;
     bool continued = false;
     for (std::string raw; std::getline(in, raw);) {
@@ -109,9 +117,10 @@ class AbaqusReader {
         lines->back().text += t;
       } else if (upper(t).rfind("*INCLUDE", 0) == 0) {
         Card c = keyword(t, where);
-        const fs::path inc = fs::path(path).parent_path() / c.param("INPUT");
+        if (dir.empty()) c.fail("*INCLUDE is not available when the file is read from memory");
+        const fs::path inc = fs::path(dir) / c.param("INPUT");
         if (!fs::exists(inc)) c.fail("cannot open '" + inc.string() + "'");
-        load(inc.string(), depth + 1, lines);
+        load(internal::read_file_bytes(inc.string()), inc.string(), folder_of(inc.string()), depth + 1, lines);
         continue;
       } else {
         lines->push_back({t, where});
@@ -424,6 +433,11 @@ class AbaqusReader {
 
 }  // namespace
 
-MeshData read_abaqus(const std::string& path) { return AbaqusReader(path).read(); }
+MeshData parse_abaqus(const std::string& bytes, const std::string& name, const std::string& include_dir) {
+  return AbaqusReader(name).read(bytes, include_dir);
+}
+MeshData read_abaqus(const std::string& path) {
+  return AbaqusReader(path).read(internal::read_file_bytes(path), folder_of(path));
+}
 
 }  // namespace dynid

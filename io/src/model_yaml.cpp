@@ -1,5 +1,6 @@
 // The `model:` section of a case file. See docs/case-file.md for the annotated reference.
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <regex>
@@ -14,6 +15,15 @@
 namespace dynid::internal {
 
 namespace {
+
+/// The largest model `generate:` builds (elements), so that a case file cannot ask for more memory than a machine
+/// has (bench/ goes to 10^6 DOFs, about 3 x 10^5 elements). Fuzzing builds use a small limit, so that the fuzzer
+/// explores the parser instead of spending its time and memory building big (valid) models.
+#ifdef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
+constexpr double kMaxGeneratedElements = 2e3;
+#else
+constexpr double kMaxGeneratedElements = 1e7;
+#endif
 
 struct Parser {
   const YamlCtx& ctx;
@@ -403,7 +413,7 @@ struct Parser {
     ctx.require_map(g, "generate");
     if (g.size() != 1) fail(g, "generate: give exactly one of beam, frame2d, frame3d");
     const std::string kind = g.begin()->first.Scalar();
-    const YAML::Node& s = g.begin()->second;
+    const YAML::Node s = g.begin()->second;  // a copy: the iterator's pair is a temporary
     ctx.require_map(s, "generate." + kind);
     auto num = [&](const char* k, double def) { return s[k] ? ctx.number(s[k], kind + " " + k) : def; };
     auto integer = [&](const char* k, int def) {
@@ -425,6 +435,13 @@ struct Parser {
       f->beam = sec("beam");
       f->mass = model.mass_type();
     };
+    // The size a generator is asked for is checked before anything is allocated (in doubles: no overflow).
+    auto check_size = [&](double elements) {
+      if (elements <= kMaxGeneratedElements) return;
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%.4g elements; at most %.4g can be generated", elements, kMaxGeneratedElements);
+      fail(s, "generate." + kind + ": " + buf);
+    };
     Model gen;
     if (kind == "beam") {
       ctx.only_keys(s, "generate.beam", {"length", "elements", "material", "section", "support"});
@@ -434,6 +451,7 @@ struct Parser {
       b.material = mat();
       b.section = sec("section");
       b.mass = model.mass_type();
+      check_size(b.elements);
       const std::string sup = s["support"] ? ctx.string(s["support"], "beam support") : "free";
       if (sup == "free") b.support = BeamSupport::Free;
       else if (sup == "cantilever") b.support = BeamSupport::Cantilever;
@@ -447,6 +465,7 @@ struct Parser {
       f.bays = integer("bays", 1);
       f.span = num("span", 1.0);
       members(&f);
+      check_size((2.0 * f.bays + 1) * f.stories * f.divisions);
       gen = make_frame2d(f);
     } else if (kind == "frame3d") {
       ctx.only_keys(s, "generate.frame3d", {"bays_x", "bays_y", "stories", "divisions", "span_x", "span_y", "height", "material", "column", "beam"});
@@ -456,6 +475,8 @@ struct Parser {
       f.span_x = num("span_x", 1.0);
       f.span_y = num("span_y", 1.0);
       members(&f);
+      const double bx = f.bays_x, by = f.bays_y;
+      check_size(((bx + 1) * (by + 1) + bx * (by + 1) + by * (bx + 1)) * f.stories * f.divisions);
       gen = make_frame3d(f);
     } else {
       fail(g.begin()->first, "generate: unknown generator '" + kind + "' (known: beam, frame2d, frame3d)");
