@@ -108,7 +108,7 @@ int run_identify(const IdentifyArgs& a, const GlobalOptions& g) {
       if (d.kind == TestData::Kind::kUff) {
         bool has_frf = false, has_time = false;
         for (const UffDataset& ds : d.uff.datasets)
-          if (const Uff58* u = std::get_if<Uff58>(&ds)) {
+          if (const Uff58* u = std::get_if<Uff58>(&ds.data)) {
             has_frf = has_frf || u->function_type == 4;
             has_time = has_time || u->function_type == 1;
           }

@@ -32,6 +32,7 @@ void register_commands(CLI::App& app, GlobalOptions& g) {
   register_detect(app, g);
   register_update(app, g);
   register_identify(app, g);
+  register_info(app, g);
 }
 
 }  // namespace dynid::cli

@@ -24,5 +24,6 @@ void register_modal(CLI::App& app, GlobalOptions& g);
 void register_detect(CLI::App& app, GlobalOptions& g);
 void register_update(CLI::App& app, GlobalOptions& g);
 void register_identify(CLI::App& app, GlobalOptions& g);  // identify and simulate-test
+void register_info(CLI::App& app, GlobalOptions& g);
 
 }  // namespace dynid::cli

@@ -1,0 +1,349 @@
+// Plain-text test data readers (see dynid/io/test_data.hpp).
+#include "dynid/io/test_data.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <map>
+
+#include "dynid/io/modal_data_io.hpp"
+#include "dynid/mesh/error.hpp"
+#include "internal/text_util.hpp"
+
+namespace dynid {
+
+using internal::parse_double;
+using internal::split_fields;
+using internal::trim;
+
+namespace {
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+bool contains(const std::string& s, const char* what) { return lower(s).find(what) != std::string::npos; }
+
+std::string where(const std::string& path, int line) { return path + ":" + std::to_string(line); }
+
+/// Rows of numbers, with the line of each row; `names` from a header row if there is one.
+struct Rows {
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> rows;
+  std::vector<int> line_of;
+};
+
+Rows read_rows(const std::string& path) {
+  const std::string bytes = internal::read_file_bytes(path);
+  internal::LineReader in(bytes);
+  Rows r;
+  std::string_view l;
+  std::size_t width = 0;
+  while (in.next(&l)) {
+    const std::string_view t = trim(l);
+    if (t.empty() || t.front() == '#') continue;
+    const auto f = split_fields(t, true);
+    std::vector<double> v(f.size());
+    std::size_t bad = f.size();
+    for (std::size_t k = 0; k < f.size() && bad == f.size(); ++k)
+      if (!parse_double(f[k], &v[k])) bad = k;
+    if (bad < f.size()) {
+      if (r.rows.empty() && r.names.empty()) {  // the header row
+        for (auto s : f) r.names.emplace_back(s);
+        continue;
+      }
+      throw InputError(where(path, in.line()) + ": column " + std::to_string(bad + 1) + ": '" + std::string(f[bad]) +
+                       "' is not a number");
+    }
+    if (r.rows.empty()) width = v.size();
+    if (v.size() != width)
+      throw InputError(where(path, in.line()) + ": " + std::to_string(v.size()) + " fields, the first data row (line " +
+                       std::to_string(r.line_of[0]) + ") has " + std::to_string(width));
+    r.rows.push_back(std::move(v));
+    r.line_of.push_back(in.line());
+  }
+  if (r.rows.empty()) throw InputError(path + ": no rows of numbers");
+  return r;
+}
+
+TextTable to_table(const Rows& r, const std::string& path, bool x_column) {
+  TextTable t;
+  t.source = path;
+  const auto n = static_cast<Eigen::Index>(r.rows.size());
+  const std::size_t width = r.rows[0].size();
+  const std::size_t first = x_column ? 1 : 0;
+  if (width <= first) throw InputError(path + ": no data columns besides the first (time or frequency) column");
+  t.x.resize(n);
+  t.columns.resize(n, static_cast<Eigen::Index>(width - first));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto& row = r.rows[static_cast<std::size_t>(i)];
+    t.x[i] = x_column ? row[0] : static_cast<double>(i);
+    for (std::size_t c = first; c < width; ++c) t.columns(i, static_cast<Eigen::Index>(c - first)) = row[c];
+  }
+  std::vector<std::string> names = r.names;
+  if (names.size() == width + 1 && lower(names.back()) == "comment") names.pop_back();
+  if (!names.empty() && names.size() != width)
+    throw InputError(path + ": the header names " + std::to_string(names.size()) + " columns, the rows have " +
+                     std::to_string(width));
+  if (x_column) t.x_name = names.empty() ? "" : names[0];
+  for (std::size_t c = first; c < width; ++c)
+    t.names.push_back(names.empty() ? "ch" + std::to_string(c - first + 1) : names[c]);
+  t.units.assign(t.names.size(), "");
+  t.dx = n > 1 ? (t.x[n - 1] - t.x[0]) / static_cast<double>(n - 1) : 0.0;
+  return t;
+}
+
+Channel guess_channel(const std::string& name, const std::string& unit) {
+  Channel c;
+  c.name = name;
+  c.unit = unit;
+  c.quantity = Quantity::kOther;
+  const std::string both = name + " " + unit;
+  if (contains(both, "force") || contains(unit, "lbf") || lower(unit) == "n" || contains(unit, "pound")) {
+    c.quantity = Quantity::kForce;
+    c.input = true;
+  } else if (contains(name, "acc") || lower(unit) == "g" || contains(unit, "m/s^2") || contains(unit, "m/s2")) {
+    c.quantity = Quantity::kAcceleration;
+  } else if (contains(name, "vel")) {
+    c.quantity = Quantity::kVelocity;
+  } else if (contains(name, "disp")) {
+    c.quantity = Quantity::kDisplacement;
+  }
+  return c;
+}
+
+Recording recording_of(const TextTable& t, double sample_rate_hz) {
+  Recording r;
+  r.source = t.source;
+  r.sample_rate_hz = sample_rate_hz;
+  for (std::size_t c = 0; c < t.names.size(); ++c) r.channels.push_back(guess_channel(t.names[c], t.units[c]));
+  r.records.push_back(t.columns);
+  r.validate(t.source);
+  return r;
+}
+
+bool same_grid(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  if (a.size() != b.size()) return false;
+  for (Eigen::Index k = 0; k < a.size(); ++k)
+    if (std::abs(a[k] - b[k]) > 1e-9 * std::max(std::abs(a[k]), std::abs(b[k]))) return false;
+  return true;
+}
+
+}  // namespace
+
+TextTable read_text_table(const std::string& path, bool x_column) {
+  return to_table(read_rows(path), path, x_column);
+}
+
+double check_even_steps(const Eigen::VectorXd& x, const std::vector<int>& line_of, const std::string& what) {
+  const Eigen::Index n = x.size();
+  if (n < 2) throw InputError(what + ": fewer than 2 samples");
+  const double first = x[1] - x[0];
+  for (Eigen::Index k = 1; k < n; ++k) {
+    const double step = x[k] - x[k - 1];
+    if (!(first > 0) || std::abs(step - first) > 0.02 * first) {
+      const std::string line = k < static_cast<Eigen::Index>(line_of.size()) ? std::to_string(line_of[k]) : "?";
+      throw InputError(what + ":" + line + ": the step changes to " + std::to_string(step) + " (it is " +
+                       std::to_string(first) + " at the start); samples must be evenly spaced and increasing");
+    }
+  }
+  return (x[n - 1] - x[0]) / static_cast<double>(n - 1);
+}
+
+Recording read_time_text(const std::string& path, double sample_rate_hz) {
+  const Rows rows = read_rows(path);
+  const TextTable t = to_table(rows, path, sample_rate_hz <= 0);
+  const double fs = sample_rate_hz > 0 ? sample_rate_hz : 1.0 / check_even_steps(t.x, rows.line_of, path);
+  return recording_of(t, fs);
+}
+
+FrfData read_frf_text(const std::string& path, const MeasuredDof& output, const MeasuredDof& input) {
+  return read_frf_text_set({path}, {output}, {input});
+}
+
+FrfData read_frf_text_set(const std::vector<std::string>& paths, const std::vector<MeasuredDof>& outputs,
+                          const std::vector<MeasuredDof>& inputs) {
+  if (paths.empty()) throw InputError("FRF text files: none given");
+  if (outputs.size() != paths.size() || inputs.size() != paths.size())
+    throw InputError("FRF text files: " + std::to_string(paths.size()) + " files need as many output and input DOFs (got " +
+                     std::to_string(outputs.size()) + " and " + std::to_string(inputs.size()) + ")");
+  FrfData h;
+  h.source = paths[0] + (paths.size() > 1 ? " and " + std::to_string(paths.size() - 1) + " more" : "");
+  auto index_of = [](std::vector<Channel>& list, const MeasuredDof& d, bool input) {
+    for (std::size_t k = 0; k < list.size(); ++k)
+      if (list[k].dof == d) return static_cast<int>(k);
+    Channel c;
+    c.dof = d;
+    c.name = to_string(d);
+    c.input = input;
+    c.quantity = input ? Quantity::kForce : Quantity::kOther;
+    list.push_back(c);
+    return static_cast<int>(list.size()) - 1;
+  };
+  std::vector<std::pair<int, int>> pair_of;
+  std::vector<TextTable> tables;
+  for (std::size_t k = 0; k < paths.size(); ++k) {
+    TextTable t = read_text_table(paths[k], true);
+    if (t.columns.cols() != 2)
+      throw InputError(paths[k] + ": expected 3 columns (frequency, real, imaginary), found " +
+                       std::to_string(t.columns.cols() + 1));
+    if (k > 0 && !same_grid(tables[0].x, t.x))
+      throw InputError(paths[k] + ": its frequencies (" + std::to_string(t.x.size()) + " lines) differ from those of " +
+                       paths[0] + " (" + std::to_string(tables[0].x.size()) + " lines)");
+    pair_of.emplace_back(index_of(h.outputs, outputs[k], false), index_of(h.inputs, inputs[k], true));
+    tables.push_back(std::move(t));
+  }
+  const int no = h.num_outputs(), ni = h.num_inputs();
+  h.frequency_hz = tables[0].x;
+  h.H.setZero(h.frequency_hz.size(), no * ni);
+  std::vector<int> from(static_cast<std::size_t>(no * ni), -1);
+  for (std::size_t k = 0; k < tables.size(); ++k) {
+    const int col = pair_of[k].first + pair_of[k].second * no;
+    if (from[static_cast<std::size_t>(col)] >= 0)
+      throw InputError(paths[k] + ": FRF " + to_string(outputs[k]) + "/" + to_string(inputs[k]) + " already read from " +
+                       paths[static_cast<std::size_t>(from[static_cast<std::size_t>(col)])]);
+    from[static_cast<std::size_t>(col)] = static_cast<int>(k);
+    h.H.col(col).real() = tables[k].columns.col(0);
+    h.H.col(col).imag() = tables[k].columns.col(1);
+  }
+  std::string missing;
+  for (int i = 0; i < ni; ++i)
+    for (int o = 0; o < no; ++o)
+      if (from[static_cast<std::size_t>(o + i * no)] < 0)
+        missing += (missing.empty() ? "" : ", ") + to_string(h.outputs[o].dof) + "/" + to_string(h.inputs[i].dof);
+  if (!missing.empty()) throw InputError(h.source + ": missing FRFs for output/input pairs " + missing);
+  h.validate(h.source);
+  return h;
+}
+
+LvmFile read_lvm(const std::string& path) {
+  const std::string bytes = internal::read_file_bytes(path);
+  internal::LineReader in(bytes);
+  std::string_view l;
+  if (!in.next(&l) || trim(l).substr(0, 19) != "LabVIEW Measurement")
+    throw InputError(path + ":1: not a LabVIEW measurement file (the first line must be 'LabVIEW Measurement')");
+  std::map<std::string, std::vector<std::string>> header;  // key -> values (per channel in the segment header)
+  int ends = 0;
+  while (ends < 2 && in.next(&l)) {
+    const auto f = split_fields(l);
+    if (f.empty()) continue;
+    if (f[0] == "***End_of_Header***") {
+      ++ends;
+      continue;
+    }
+    std::vector<std::string>& v = header[std::string(f[0])];
+    v.clear();
+    for (std::size_t k = 1; k < f.size(); ++k) v.emplace_back(f[k]);
+  }
+  if (ends < 2) throw InputError(path + ": the file ends inside its header (two ***End_of_Header*** lines expected)");
+  auto value = [&](const char* key) { return header.count(key) && !header[key].empty() ? header[key][0] : ""; };
+  if (value("Separator") != "" && value("Separator") != "Tab")
+    throw InputError(path + ": separator '" + value("Separator") + "' is not supported (only Tab)");
+  const bool comma = value("Decimal_Separator") == ",";
+  const std::string xcols = value("X_Columns").empty() ? "One" : value("X_Columns");
+  LvmFile out;
+  parse_double(value("Delta_X"), &out.header_delta_x);
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> rows;
+  std::vector<int> line_of;
+  while (in.next(&l)) {
+    if (trim(l).empty()) continue;
+    // Fields are tab separated; names may hold blanks.
+    std::vector<std::string> f;
+    std::size_t start = 0;
+    while (start <= l.size()) {
+      const std::size_t tab = std::min(l.find('\t', start), l.size());
+      f.emplace_back(trim(l.substr(start, tab - start)));
+      start = tab + 1;
+    }
+    while (!f.empty() && f.back().empty()) f.pop_back();
+    if (f.empty()) continue;
+    std::vector<double> v(f.size());
+    bool numeric = true;
+    for (std::size_t k = 0; k < f.size() && numeric; ++k) {
+      if (comma) std::replace(f[k].begin(), f[k].end(), ',', '.');
+      numeric = parse_double(f[k], &v[k]);
+    }
+    if (!numeric) {
+      if (rows.empty() && names.empty()) {
+        names = f;
+        continue;
+      }
+      if (f[0] == "***End_of_Header***" || f[0] == "Channels")
+        throw InputError(where(path, in.line()) + ": a second segment; dynid reads single-segment LVM files");
+      throw InputError(where(path, in.line()) + ": '" + f[0] + "...' is not a row of numbers");
+    }
+    if (!rows.empty() && v.size() != rows[0].size())
+      throw InputError(where(path, in.line()) + ": " + std::to_string(v.size()) + " fields, the first row has " +
+                       std::to_string(rows[0].size()));
+    rows.push_back(std::move(v));
+    line_of.push_back(in.line());
+  }
+  if (rows.empty()) throw InputError(path + ": no data rows after the header");
+  const std::size_t width = rows[0].size();
+  if (names.size() > width) names.resize(width);  // the trailing "Comment" column
+  // Which columns are X and which are channels.
+  std::vector<std::size_t> ycols;
+  int xcol = -1;
+  for (std::size_t c = 0; c < width; ++c) {
+    const bool is_x = (xcols == "One" && c == 0) || (xcols == "Multi" && c % 2 == 0);
+    if (is_x && xcol < 0) xcol = static_cast<int>(c);
+    if (!is_x) ycols.push_back(c);
+  }
+  if (ycols.empty()) throw InputError(path + ": no channel columns");
+  TextTable& t = out.table;
+  t.source = path;
+  const auto n = static_cast<Eigen::Index>(rows.size());
+  t.x.resize(n);
+  t.columns.resize(n, static_cast<Eigen::Index>(ycols.size()));
+  double x0 = 0;
+  parse_double(value("X0"), &x0);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto& row = rows[static_cast<std::size_t>(i)];
+    t.x[i] = xcol >= 0 ? row[static_cast<std::size_t>(xcol)] : x0 + static_cast<double>(i) * out.header_delta_x;
+    for (std::size_t c = 0; c < ycols.size(); ++c) t.columns(i, static_cast<Eigen::Index>(c)) = row[ycols[c]];
+  }
+  t.x_name = xcol >= 0 && static_cast<std::size_t>(xcol) < names.size() ? names[static_cast<std::size_t>(xcol)] : "X";
+  const std::vector<std::string> units = header.count("Y_Unit_Label") ? header["Y_Unit_Label"] : std::vector<std::string>{};
+  for (std::size_t c = 0; c < ycols.size(); ++c) {
+    t.names.push_back(ycols[c] < names.size() ? names[ycols[c]] : "ch" + std::to_string(c + 1));
+    t.units.push_back(c < units.size() ? units[c] : "");
+  }
+  t.dx = check_even_steps(t.x, line_of, path);
+  out.spectrum = lower(value("X_Dimension")) == "frequency";
+  for (const std::string& name : t.names)
+    out.spectrum = out.spectrum || contains(name, "fft") || contains(name, "spectrum") || contains(name, "psd");
+  if (!out.spectrum) out.recording = recording_of(t, 1.0 / t.dx);
+  return out;
+}
+
+TestData read_test_data(const std::string& path, double sample_rate_hz) {
+  std::string ext = lower(std::filesystem::path(path).extension().string());
+  if (ext != ".uff" && ext != ".unv" && ext != ".lvm" && ext != ".txt" && ext != ".csv" && ext != ".dat" && ext != ".tsv") {
+    // By content: the first non-blank line.
+    const std::string head = internal::read_file_bytes(path).substr(0, 4096);
+    internal::LineReader in(head);
+    std::string_view l;
+    while (in.next(&l) && trim(l).empty()) {
+    }
+    ext = trim(l) == "-1" ? ".uff" : trim(l).substr(0, 19) == "LabVIEW Measurement" ? ".lvm" : ".txt";
+  }
+  TestData d;
+  if (ext == ".uff" || ext == ".unv") {
+    d.kind = TestData::Kind::kUff;
+    d.uff = read_uff(path);
+  } else if (ext == ".lvm") {
+    LvmFile f = read_lvm(path);
+    d.kind = f.spectrum ? TestData::Kind::kSpectrum : TestData::Kind::kTimeHistory;
+    d.table = std::move(f.table);
+    d.recording = std::move(f.recording);
+  } else {
+    d.kind = TestData::Kind::kTimeHistory;
+    d.recording = read_time_text(path, sample_rate_hz);
+  }
+  return d;
+}
+
+}  // namespace dynid

@@ -1,0 +1,1154 @@
+// Universal File Format reader and writer (see dynid/io/uff.hpp for the formats).
+#include "dynid/io/uff.hpp"
+
+#include <algorithm>
+#include <cstdarg>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <tuple>
+
+#include "dynid/io/output.hpp"
+#include "dynid/mesh/error.hpp"
+#include "internal/text_util.hpp"
+
+namespace dynid {
+
+using internal::parse_double;
+using internal::parse_int;
+using internal::record_numbers;
+using internal::rtrim;
+using internal::trim;
+
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586476925286766559;
+constexpr long long kMaxPoints = 1LL << 30;  // no UFF function holds a billion points
+
+/// Abscissa of point k of an evenly spaced function; the reader and the writer's "is it even?" test both use it.
+double even_abscissa(double x0, double dx, Eigen::Index k) { return x0 + static_cast<double>(k) * dx; }
+
+/// Where we are in a file, for error messages: "file: dataset 58 starting at line 120, record 7 (line 127): ...".
+struct Ctx {
+  const std::string& file;
+  std::string type;
+  int first_line;
+  [[noreturn]] void fail(const std::string& record, int line, const std::string& what) const {
+    std::string m = file + ": dataset " + type + " starting at line " + std::to_string(first_line);
+    if (!record.empty()) m += ", " + record;
+    if (line > 0) m += " (line " + std::to_string(line) + ")";
+    throw InputError(m + ": " + what);
+  }
+};
+
+/// The lines of an ASCII dataset between its type line and the closing "-1".
+struct Block {
+  std::vector<std::string_view> lines;
+  std::vector<int> line_no;
+  bool closed = false;  ///< the closing "-1" was found
+  int last_line = 0;
+};
+
+bool is_delimiter(std::string_view l) { return trim(l) == "-1"; }
+
+Block read_block(internal::LineReader& in) {
+  Block b;
+  std::string_view l;
+  while (in.next(&l)) {
+    if (is_delimiter(l)) {
+      b.closed = true;
+      break;
+    }
+    b.lines.push_back(l);
+    b.line_no.push_back(in.line());
+  }
+  b.last_line = in.line();
+  return b;
+}
+
+std::string record_name(int r) { return "record " + std::to_string(r); }
+
+/// Integer fields of a record: by blanks, else by fixed widths. At least `min_fields` are required; missing
+/// optional ones are 0.
+std::vector<int> int_record(const Ctx& c, std::string_view line, int line_no, int record,
+                            const std::vector<int>& widths, std::size_t min_fields, const std::string& what) {
+  std::vector<double> v;
+  if (!record_numbers(line, widths, &v) || v.size() < min_fields)
+    c.fail(record_name(record), line_no,
+           "expected " + std::to_string(min_fields) + " integer fields (" + what + "), found '" +
+               std::string(rtrim(line)) + "'");
+  std::vector<int> out;
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    if (v[k] != std::floor(v[k]) || std::abs(v[k]) > 2147483647.0)
+      c.fail(record_name(record), line_no, "field " + std::to_string(k + 1) + " (" + what + ") must be an integer, found " +
+                                               std::to_string(v[k]));
+    out.push_back(static_cast<int>(v[k]));
+  }
+  return out;
+}
+
+std::string field_text(std::string_view line, std::size_t begin, std::size_t width) {
+  if (begin >= line.size()) return "";
+  return std::string(trim(line.substr(begin, width)));
+}
+
+// ---- 58 -------------------------------------------------------------------------------------------------------
+
+/// Record 6 of a 58: fixed columns (the entity names may contain blanks), else free format with 10 fields.
+void parse58_record6(const Ctx& c, std::string_view l, int ln, Uff58* d) {
+  static const std::size_t col[8] = {0, 5, 15, 20, 41, 51, 66, 76};
+  static const std::size_t wid[8] = {5, 10, 5, 10, 10, 4, 10, 4};
+  int v[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  bool fixed = true;
+  for (int k = 0; k < 8 && fixed; ++k) {
+    const std::string f = field_text(l, col[k], wid[k]);
+    if (f.empty() && k > 0) continue;  // optional trailing fields
+    fixed = parse_int(f, &v[k]);
+  }
+  if (fixed) {
+    d->response_name = field_text(l, 31, 10);
+    d->reference_name = field_text(l, 56, 10);
+  } else {
+    const auto t = internal::split_fields(l);
+    const int idx[8] = {0, 1, 2, 3, 5, 6, 8, 9};
+    bool ok = t.size() == 10;
+    for (int k = 0; k < 8 && ok; ++k) ok = parse_int(t[idx[k]], &v[k]);
+    if (!ok)
+      c.fail(record_name(6), ln,
+             "expected function type, function id, version, load case, response name, node, direction, reference "
+             "name, node, direction (I5,I10,I5,I10,1X,A10,I10,I4,1X,A10,I10,I4), found '" + std::string(rtrim(l)) + "'");
+    d->response_name = std::string(t[4]);
+    d->reference_name = std::string(t[7]);
+  }
+  d->function_type = v[0];
+  d->function_id = v[1];
+  d->version = v[2];
+  d->load_case = v[3];
+  d->response_node = v[4];
+  d->response_direction = v[5];
+  d->reference_node = v[6];
+  d->reference_direction = v[7];
+  if (std::abs(d->response_direction) > 6 || std::abs(d->reference_direction) > 6)
+    c.fail(record_name(6), ln, "directions must be -6..6, found " + std::to_string(d->response_direction) + " and " +
+                                   std::to_string(d->reference_direction));
+}
+
+void parse58_record7(const Ctx& c, std::string_view l, int ln, Uff58* d, long long* num_points) {
+  std::vector<double> v;
+  if (!record_numbers(l, {10, 10, 10, 13, 13, 13}, &v) || v.size() < 3)
+    c.fail(record_name(7), ln, "expected ordinate data type, number of points, abscissa spacing, minimum, increment, "
+                               "z value (3I10,3E13.5), found '" + std::string(rtrim(l)) + "'");
+  const int type = static_cast<int>(v[0]);
+  if (v[0] != type || (type != 2 && type != 4 && type != 5 && type != 6))
+    c.fail(record_name(7), ln, "ordinate data type must be 2 (real single), 4 (real double), 5 (complex single) or "
+                               "6 (complex double), found " + std::to_string(v[0]));
+  if (!(v[1] >= 1 && v[1] <= static_cast<double>(kMaxPoints)) || v[1] != std::floor(v[1]))
+    c.fail(record_name(7), ln, "number of points must be an integer in 1.." + std::to_string(kMaxPoints) + ", found " +
+                                   std::to_string(v[1]));
+  if (v[2] != 0 && v[2] != 1)
+    c.fail(record_name(7), ln, "abscissa spacing must be 0 (uneven) or 1 (even), found " + std::to_string(v[2]));
+  d->ordinate_type = type;
+  *num_points = static_cast<long long>(v[1]);
+  d->even = v[2] == 1;
+  if (d->even && v.size() < 5)
+    c.fail(record_name(7), ln, "even abscissa spacing needs the abscissa minimum and increment (fields 4 and 5)");
+  d->x_min = v.size() > 3 ? v[3] : 0;
+  d->dx = v.size() > 4 ? v[4] : 0;
+  d->z_value = v.size() > 5 ? v[5] : 0;
+  if (d->even && !(std::isfinite(d->x_min) && std::isfinite(d->dx) && d->dx > 0))
+    c.fail(record_name(7), ln, "abscissa increment must be > 0 for even spacing, found " + std::to_string(d->dx));
+}
+
+/// Records 8-11: I10,3I5,2(1X,A20); free format (4 integers, label, unit) if the columns do not fit.
+UffAxis parse58_axis(const Ctx& c, std::string_view l, int ln, int record) {
+  UffAxis a;
+  int v[4] = {0, 0, 0, 0};
+  static const std::size_t col[4] = {0, 10, 15, 20}, wid[4] = {10, 5, 5, 5};
+  bool fixed = true;
+  for (int k = 0; k < 4 && fixed; ++k) {
+    const std::string f = field_text(l, col[k], wid[k]);
+    fixed = f.empty() ? k > 0 : parse_int(f, &v[k]);
+  }
+  if (fixed) {
+    a.label = field_text(l, 26, 20);
+    a.unit = field_text(l, 47, 20);
+  } else {
+    const auto t = internal::split_fields(l);
+    bool ok = t.size() >= 4;
+    for (int k = 0; k < 4 && ok; ++k) ok = parse_int(t[k], &v[k]);
+    if (!ok)
+      c.fail(record_name(record), ln, "expected specific data type, 3 unit exponents, axis label and units label "
+                                      "(I10,3I5,2(1X,A20)), found '" + std::string(rtrim(l)) + "'");
+    a.label = t.size() > 4 ? std::string(t[4]) : "";
+    a.unit = t.size() > 5 ? std::string(t[5]) : "";
+  }
+  a.data_type = v[0];
+  a.length_exp = v[1];
+  a.force_exp = v[2];
+  a.temperature_exp = v[3];
+  return a;
+}
+
+int values_per_point(const Uff58& d) { return (d.is_complex() ? 2 : 1) + (d.even ? 0 : 1); }
+
+/// Fills x and y from the flat values (y, re im, x y, or x re im per point).
+void unpack58(const std::vector<double>& v, Uff58* d) {
+  const int per = values_per_point(*d);
+  const Eigen::Index n = static_cast<Eigen::Index>(v.size()) / per;
+  d->x.resize(n);
+  d->y.resize(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double* p = &v[static_cast<std::size_t>(k * per)];
+    int j = 0;
+    d->x[k] = d->even ? even_abscissa(d->x_min, d->dx, k) : p[j++];
+    const double re = p[j++];
+    d->y[k] = std::complex<double>(re, d->is_complex() ? p[j] : 0.0);
+  }
+  if (!d->even && n > 0) {
+    d->x_min = d->x[0];
+    d->dx = 0;
+  }
+}
+
+/// ASCII record 12 widths by type (the fallback when numbers run together), as pyuff reads them.
+std::vector<int> data_widths(const Uff58& d) {
+  if (!d.is_double()) return {13};
+  if (d.even) return {20};
+  return d.is_complex() ? std::vector<int>{13, 20, 20} : std::vector<int>{13, 20};
+}
+
+void parse58_header(const Ctx& c, const std::vector<std::string_view>& lines, const std::vector<int>& ln, Uff58* d,
+                    long long* num_points) {
+  for (int k = 0; k < 5; ++k) d->id[k] = std::string(rtrim(lines[k]));
+  parse58_record6(c, lines[5], ln[5], d);
+  parse58_record7(c, lines[6], ln[6], d, num_points);
+  d->abscissa = parse58_axis(c, lines[7], ln[7], 8);
+  d->ordinate = parse58_axis(c, lines[8], ln[8], 9);
+  d->denominator = parse58_axis(c, lines[9], ln[9], 10);
+  d->z_axis = parse58_axis(c, lines[10], ln[10], 11);
+}
+
+Uff58 read58_ascii(const Ctx& c, const Block& b) {
+  if (b.lines.size() < 11)
+    c.fail(record_name(static_cast<int>(b.lines.size()) + 1), b.last_line,
+           "the header has " + std::to_string(b.lines.size()) + " of its 11 records (file truncated?)");
+  Uff58 d;
+  long long n = 0;
+  parse58_header(c, b.lines, b.line_no, &d, &n);
+  const long long expected = n * values_per_point(d);
+  const std::vector<int> widths = data_widths(d);
+  std::vector<double> values, line_values;
+  for (std::size_t k = 11; k < b.lines.size(); ++k) {
+    if (!record_numbers(b.lines[k], widths, &line_values)) {
+      if (!b.closed && k + 1 == b.lines.size())  // cut inside a number
+        c.fail(record_name(12), b.line_no[k], "found about " + std::to_string(values.size()) + " of the " +
+                                                  std::to_string(expected) + " values declared; the file ends inside "
+                                                  "the data without the closing -1 (truncated?)");
+      c.fail(record_name(12), b.line_no[k], "value " + std::to_string(values.size() + 1) + ": not a number in '" +
+                                                std::string(rtrim(b.lines[k])) + "'");
+    }
+    values.insert(values.end(), line_values.begin(), line_values.end());
+    if (static_cast<long long>(values.size()) > expected)
+      c.fail(record_name(12), b.line_no[k], "more values than the " + std::to_string(expected) + " declared (" +
+                                                std::to_string(n) + " points in record 7)");
+  }
+  if (static_cast<long long>(values.size()) < expected)
+    c.fail(record_name(12), b.last_line, "found " + std::to_string(values.size()) + " of the " + std::to_string(expected) +
+                                             " values declared (" + std::to_string(n) + " points in record 7)" +
+                                             (b.closed ? "" : "; the file ends without the closing -1 (truncated?)"));
+  if (!b.closed) c.fail(record_name(12), b.last_line, "the file ends without the closing -1 line (truncated?)");
+  unpack58(values, &d);
+  return d;
+}
+
+double decode_float(const unsigned char* p, int size, bool big_endian) {
+  std::uint64_t u = 0;
+  for (int k = 0; k < size; ++k) {
+    const int byte = big_endian ? k : size - 1 - k;
+    u = (u << 8) | p[byte];
+  }
+  if (size == 4) {
+    const auto u32 = static_cast<std::uint32_t>(u);
+    float f;
+    std::memcpy(&f, &u32, 4);
+    return f;
+  }
+  double v;
+  std::memcpy(&v, &u, 8);
+  return v;
+}
+
+Uff58 read58_binary(const Ctx& c, internal::LineReader& in, std::string_view type_line, int type_ln) {
+  // Type line: 58b, byte order, floating-point format, number of ASCII lines, number of bytes, 4 unused.
+  std::string_view rest = trim(type_line);
+  rest = rest.substr(std::min(rest.size(), rest.find_first_of("bB") + 1));
+  std::vector<double> h;
+  if (!record_numbers(rest, {6, 6, 12, 12, 6, 6, 12, 12}, &h) || h.size() < 4)
+    c.fail("header line", type_ln, "expected '58b byte_order fp_format num_ascii_lines num_bytes ...', found '" +
+                                       std::string(rtrim(type_line)) + "'");
+  if (h[0] != 1 && h[0] != 2)
+    c.fail("header line", type_ln, "byte order must be 1 (little endian) or 2 (big endian), found " + std::to_string(h[0]));
+  if (h[1] != 2)
+    c.fail("header line", type_ln, "floating-point format " + std::to_string(h[1]) +
+                                       " is not supported (only 2, IEEE 754); convert the file to IEEE or ASCII");
+  if (h[2] != 11)
+    c.fail("header line", type_ln, "expected 11 ASCII header lines, the file says " + std::to_string(h[2]));
+  if (!(h[3] >= 0 && h[3] <= 8.0 * 3 * kMaxPoints))
+    c.fail("header line", type_ln, "number of bytes " + std::to_string(h[3]) + " is out of range");
+  Block head;
+  std::string_view l;
+  while (head.lines.size() < 11 && in.next(&l)) {
+    if (is_delimiter(l))
+      c.fail(record_name(static_cast<int>(head.lines.size()) + 1), in.line(), "-1 inside the 11 header records");
+    head.lines.push_back(l);
+    head.line_no.push_back(in.line());
+  }
+  if (head.lines.size() < 11)
+    c.fail(record_name(static_cast<int>(head.lines.size()) + 1), in.line(),
+           "the header has " + std::to_string(head.lines.size()) + " of its 11 records (file truncated?)");
+  Uff58 d;
+  d.binary = true;
+  d.big_endian = h[0] == 2;
+  long long n = 0;
+  parse58_header(c, head.lines, head.line_no, &d, &n);
+  const int size = d.is_double() ? 8 : 4;
+  const long long count = n * values_per_point(d);
+  const long long need = count * size;
+  const long long declared = static_cast<long long>(h[3]);
+  const int data_line = in.line() + 1;
+  if (static_cast<long long>(in.remaining()) < need)
+    c.fail(record_name(12), data_line, "binary data: " + std::to_string(need) + " bytes needed for " + std::to_string(n) +
+                                           " points, the file has " + std::to_string(in.remaining()) + " left (truncated?)");
+  const std::string_view bytes = in.take_bytes(static_cast<std::size_t>(need));
+  if (declared > need && static_cast<long long>(in.remaining()) >= declared - need)
+    in.take_bytes(static_cast<std::size_t>(declared - need));  // padding some writers add
+  std::vector<double> values(static_cast<std::size_t>(count));
+  const auto* p = reinterpret_cast<const unsigned char*>(bytes.data());
+  for (long long k = 0; k < count; ++k) values[static_cast<std::size_t>(k)] = decode_float(p + k * size, size, d.big_endian);
+  bool closed = false;
+  while (in.next(&l)) {
+    if (is_delimiter(l)) {
+      closed = true;
+      break;
+    }
+    if (!trim(l).empty())
+      c.fail(record_name(12), in.line(), "the binary data (" + std::to_string(need) +
+                                             " bytes) is not followed by the closing -1 (header says " +
+                                             std::to_string(declared) + " bytes)");
+  }
+  if (!closed) c.fail(record_name(12), in.line(), "the file ends without the closing -1 line (truncated?)");
+  unpack58(values, &d);
+  return d;
+}
+
+// ---- 55 -------------------------------------------------------------------------------------------------------
+
+Uff55 read55(const Ctx& c, const Block& b) {
+  if (b.lines.size() < 8)
+    c.fail(record_name(static_cast<int>(b.lines.size()) + 1), b.last_line,
+           "the header has " + std::to_string(b.lines.size()) + " of its 8 records (file truncated?)");
+  Uff55 d;
+  for (int k = 0; k < 5; ++k) d.id[k] = std::string(rtrim(b.lines[k]));
+  const auto r6 = int_record(c, b.lines[5], b.line_no[5], 6, {10}, 6,
+                             "model type, analysis type, data characteristic, specific data type, data type, values per node");
+  d.model_type = r6[0];
+  d.analysis_type = r6[1];
+  d.data_characteristic = r6[2];
+  d.data_type_code = r6[3];
+  if (r6[4] != 2 && r6[4] != 5)
+    c.fail(record_name(6), b.line_no[5], "data type (field 5) must be 2 (real) or 5 (complex), found " + std::to_string(r6[4]));
+  d.complex = r6[4] == 5;
+  d.values_per_node = r6[5];
+  if (d.values_per_node < 1 || d.values_per_node > 6)
+    c.fail(record_name(6), b.line_no[5], "values per node (field 6) must be 1..6, found " + std::to_string(d.values_per_node));
+  d.record7 = int_record(c, b.lines[6], b.line_no[6], 7, {10}, 2, "number of integers, number of reals, ...");
+  std::vector<double> r8;
+  if (!record_numbers(b.lines[7], {13}, &r8) || r8.empty())
+    c.fail(record_name(8), b.line_no[7], "expected real values (6E13.5), found '" + std::string(rtrim(b.lines[7])) + "'");
+  d.record8 = r8;
+  const int per_node = d.values_per_node * (d.complex ? 2 : 1);
+  std::vector<double> vals, line_vals;
+  std::size_t k = 8;
+  while (k < b.lines.size()) {
+    if (trim(b.lines[k]).empty()) {
+      ++k;
+      continue;
+    }
+    int node = 0;
+    if (!parse_int(b.lines[k], &node))
+      c.fail(record_name(9), b.line_no[k], "expected a node number (I10), found '" + std::string(rtrim(b.lines[k])) + "'");
+    const int node_line = b.line_no[k];
+    ++k;
+    std::size_t got = 0;
+    while (got < static_cast<std::size_t>(per_node) && k < b.lines.size()) {
+      if (!record_numbers(b.lines[k], {13}, &line_vals))
+        c.fail(record_name(10), b.line_no[k], "node " + std::to_string(node) + ": not a number in '" +
+                                                  std::string(rtrim(b.lines[k])) + "'");
+      got += line_vals.size();
+      vals.insert(vals.end(), line_vals.begin(), line_vals.end());
+      ++k;
+    }
+    if (got != static_cast<std::size_t>(per_node))
+      c.fail(record_name(10), node_line, "node " + std::to_string(node) + ": expected " + std::to_string(per_node) +
+                                             " values, found " + std::to_string(got) + (b.closed ? "" : " (file truncated?)"));
+    d.nodes.push_back(node);
+  }
+  if (!b.closed) c.fail(record_name(10), b.last_line, "the file ends without the closing -1 line (truncated?)");
+  const auto nn = static_cast<Eigen::Index>(d.nodes.size());
+  d.values.resize(nn, d.values_per_node);
+  for (Eigen::Index i = 0; i < nn; ++i)
+    for (int j = 0; j < d.values_per_node; ++j) {
+      const std::size_t at = static_cast<std::size_t>(i * per_node) + (d.complex ? 2 * j : j);
+      d.values(i, j) = std::complex<double>(vals[at], d.complex ? vals[at + 1] : 0.0);
+    }
+  return d;
+}
+
+// ---- 15, 2411, 2412, 164 --------------------------------------------------------------------------------------
+
+void require_closed(const Ctx& c, const Block& b, const std::string& record) {
+  if (!b.closed) c.fail(record, b.last_line, "the file ends without the closing -1 line (truncated?)");
+}
+
+UffNode node_from(const Ctx& c, const std::vector<double>& v, std::size_t first_real, int ln, int record) {
+  UffNode n;
+  int ints[4] = {0, 0, 0, 0};
+  for (int k = 0; k < 4; ++k) {
+    if (v[k] != std::floor(v[k]) || std::abs(v[k]) > 2147483647.0)
+      c.fail(record_name(record), ln, "field " + std::to_string(k + 1) + " must be an integer");
+    ints[k] = static_cast<int>(v[k]);
+  }
+  n.id = ints[0];
+  n.definition_cs = ints[1];
+  n.displacement_cs = ints[2];
+  n.colour = ints[3];
+  n.x = Eigen::Vector3d(v[first_real], v[first_real + 1], v[first_real + 2]);
+  return n;
+}
+
+UffNodes read15(const Ctx& c, const Block& b) {
+  UffNodes d;
+  std::vector<double> v;
+  for (std::size_t k = 0; k < b.lines.size(); ++k) {
+    if (trim(b.lines[k]).empty()) continue;
+    if (!record_numbers(b.lines[k], {10, 10, 10, 10, 13, 13, 13}, &v) || v.size() != 7)
+      c.fail(record_name(1), b.line_no[k], "node " + std::to_string(d.nodes.size() + 1) +
+                                               ": expected 7 fields (label, 2 coordinate systems, colour, x, y, z; "
+                                               "4I10,3E13.5), found '" + std::string(rtrim(b.lines[k])) + "'");
+    d.nodes.push_back(node_from(c, v, 4, b.line_no[k], 1));
+  }
+  require_closed(c, b, record_name(1));
+  return d;
+}
+
+UffNodes read2411(const Ctx& c, const Block& b) {
+  UffNodes d;
+  std::vector<double> v, x;
+  for (std::size_t k = 0; k < b.lines.size(); k += 2) {
+    if (k + 1 >= b.lines.size())
+      c.fail(record_name(2), b.last_line, "node " + std::to_string(d.nodes.size() + 1) + ": coordinates missing");
+    if (!record_numbers(b.lines[k], {10}, &v) || v.size() != 4)
+      c.fail(record_name(1), b.line_no[k], "expected 4 integers (label, export and displacement coordinate systems, "
+                                           "colour; 4I10), found '" + std::string(rtrim(b.lines[k])) + "'");
+    if (!record_numbers(b.lines[k + 1], {25}, &x) || x.size() != 3)
+      c.fail(record_name(2), b.line_no[k + 1], "expected 3 coordinates (3D25.16), found '" +
+                                                   std::string(rtrim(b.lines[k + 1])) + "'");
+    v.insert(v.end(), x.begin(), x.end());
+    d.nodes.push_back(node_from(c, v, 4, b.line_no[k], 1));
+  }
+  require_closed(c, b, record_name(2));
+  return d;
+}
+
+bool is_beam_descriptor(int fe) { return fe == 11 || (fe >= 21 && fe <= 24); }
+
+UffElements read2412(const Ctx& c, const Block& b, std::vector<std::string>* notes) {
+  UffElements d;
+  std::size_t k = 0;
+  int higher_order = 0;
+  while (k < b.lines.size()) {
+    if (trim(b.lines[k]).empty()) {
+      ++k;
+      continue;
+    }
+    const auto r1 = int_record(c, b.lines[k], b.line_no[k], 1, {10}, 6,
+                               "label, FE descriptor, physical property, material property, colour, number of nodes");
+    UffElement e{r1[0], r1[1], r1[2], r1[3], r1[4], {}};
+    const int nn = r1[5];
+    if (nn < 1 || nn > 64)
+      c.fail(record_name(1), b.line_no[k], "element " + std::to_string(e.id) + ": number of nodes must be 1..64, found " +
+                                               std::to_string(nn));
+    ++k;
+    if (is_beam_descriptor(e.fe_descriptor)) ++k;  // record 2: orientation node, cross sections
+    while (static_cast<int>(e.nodes.size()) < nn && k < b.lines.size()) {
+      const auto ids = int_record(c, b.lines[k], b.line_no[k], 3, {10}, 1, "node labels, 8I10");
+      e.nodes.insert(e.nodes.end(), ids.begin(), ids.end());
+      ++k;
+    }
+    if (static_cast<int>(e.nodes.size()) != nn)
+      c.fail(record_name(3), b.last_line, "element " + std::to_string(e.id) + ": expected " + std::to_string(nn) +
+                                              " node labels, found " + std::to_string(e.nodes.size()));
+    if (nn > 4) ++higher_order;
+    d.elements.push_back(std::move(e));
+  }
+  require_closed(c, b, record_name(3));
+  if (higher_order > 0)
+    notes->push_back(c.file + ": dataset 2412 starting at line " + std::to_string(c.first_line) + ": " +
+                     std::to_string(higher_order) + " elements with more than 4 nodes kept as node lists only");
+  return d;
+}
+
+UffUnits read164(const Ctx& c, const Block& b) {
+  if (b.lines.size() < 2)
+    c.fail(record_name(static_cast<int>(b.lines.size()) + 1), b.last_line, "units dataset is incomplete (file truncated?)");
+  UffUnits u;
+  const std::string_view r1 = b.lines[0];
+  if (!parse_int(field_text(r1, 0, 10), &u.code))
+    c.fail(record_name(1), b.line_no[0], "expected the units code (I10), found '" + std::string(rtrim(r1)) + "'");
+  u.description = field_text(r1, 10, 20);
+  const std::string tm = field_text(r1, 30, 10);
+  u.temperature_mode = 2;
+  if (!tm.empty() && !parse_int(tm, &u.temperature_mode))
+    c.fail(record_name(1), b.line_no[0], "temperature mode (columns 31-40) must be an integer, found '" + tm + "'");
+  std::vector<double> all, v;
+  for (std::size_t k = 1; k < b.lines.size(); ++k) {
+    if (!record_numbers(b.lines[k], {25}, &v))
+      c.fail(record_name(static_cast<int>(k) + 1), b.line_no[k], "not a number in '" + std::string(rtrim(b.lines[k])) + "'");
+    all.insert(all.end(), v.begin(), v.end());
+  }
+  if (all.size() < 3)
+    c.fail(record_name(2), b.line_no[1], "expected the length, force and temperature factors (3D25.17)");
+  u.length = all[0];
+  u.force = all[1];
+  u.temperature = all[2];
+  u.temperature_offset = all.size() > 3 ? all[3] : 0.0;
+  require_closed(c, b, record_name(3));
+  return u;
+}
+
+}  // namespace
+
+// ---- reading --------------------------------------------------------------------------------------------------
+
+UffFile parse_uff(const std::string& bytes, const std::string& name) {
+  UffFile f;
+  f.source = name;
+  internal::LineReader in(bytes);
+  std::string_view l;
+  while (in.next(&l)) {
+    if (trim(l).empty()) continue;
+    if (!is_delimiter(l))
+      throw InputError(name + ": line " + std::to_string(in.line()) + ": expected the -1 line that starts a dataset, found '" +
+                       std::string(trim(l)).substr(0, 40) + "'" + (f.datasets.empty() ? " (is this a UFF file?)" : ""));
+    const int start = in.line();
+    std::string_view type_line;
+    if (!in.next(&type_line))
+      throw InputError(name + ": dataset starting at line " + std::to_string(start) + ": the file ends after its -1 line");
+    const std::string_view tok = trim(type_line).substr(0, trim(type_line).find_first_of(" \t"));
+    const bool binary = !tok.empty() && (tok.back() == 'b' || tok.back() == 'B');
+    int type = 0;
+    if (!parse_int(binary ? tok.substr(0, tok.size() - 1) : tok, &type))
+      throw InputError(name + ": dataset starting at line " + std::to_string(start) + " (line " + std::to_string(in.line()) +
+                       "): expected the dataset number, found '" + std::string(trim(type_line)).substr(0, 40) + "'");
+    UffDataset ds;
+    ds.type = type;
+    ds.first_line = start;
+    const Ctx c{name, std::string(tok), start};
+    if (binary) {
+      if (type != 58) c.fail("", in.line(), "binary datasets other than 58b are not supported; convert it to ASCII");
+      ds.data = read58_binary(c, in, type_line, in.line());
+    } else {
+      const Block b = read_block(in);
+      switch (type) {
+        case 58: ds.data = read58_ascii(c, b); break;
+        case 55: ds.data = read55(c, b); break;
+        case 15: ds.data = read15(c, b); break;
+        case 2411: ds.data = read2411(c, b); break;
+        case 2412: ds.data = read2412(c, b, &f.notes); break;
+        case 164: ds.data = read164(c, b); break;
+        default:
+          if (!b.closed) c.fail("", b.last_line, "the file ends without the closing -1 line (truncated?)");
+          ds.data = UffSkipped{};
+      }
+    }
+    f.datasets.push_back(std::move(ds));
+  }
+  if (f.datasets.empty()) throw InputError(name + ": no UFF datasets (the file is empty or blank)");
+  return f;
+}
+
+UffFile read_uff(const std::string& path) { return parse_uff(internal::read_file_bytes(path), path); }
+
+double Uff55::frequency_hz() const {
+  if ((analysis_type == 3 || analysis_type == 7) && record8.size() >= 2)
+    return std::abs(std::complex<double>(record8[0], record8[1])) / kTwoPi;
+  return record8.empty() ? 0.0 : record8[0];
+}
+
+double Uff55::damping_ratio() const {
+  if ((analysis_type == 3 || analysis_type == 7) && record8.size() >= 2) {
+    const double mag = std::abs(std::complex<double>(record8[0], record8[1]));
+    return mag > 0 ? -record8[0] / mag : 0.0;
+  }
+  return analysis_type == 2 && record8.size() >= 3 ? record8[2] : 0.0;
+}
+
+// ---- writing --------------------------------------------------------------------------------------------------
+
+namespace {
+
+/// A real with 17 significant digits (reads back to the same double), 25 characters wide.
+void put_real(std::string* s, double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%25.16E", v);
+  *s += b;
+}
+
+/// printf-formatted text appended to s.
+void put_text(std::string* s, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+void put_text(std::string* s, const char* fmt, ...) {
+  char b[256];
+  va_list ap;
+  va_start(ap, fmt);
+  std::vsnprintf(b, sizeof b, fmt, ap);
+  va_end(ap);
+  *s += b;
+}
+
+/// The "-1" and type lines that open an ASCII dataset.
+std::string open_dataset(int type) {
+  std::string s;
+  put_text(&s, "%6d\n", -1);
+  put_text(&s, "%6d\n", type);
+  return s;
+}
+
+/// Text fields are cut to their width and must not hold line breaks.
+std::string text_field(const std::string& s, std::size_t width) {
+  std::string t = s.substr(0, width);
+  for (char& ch : t)
+    if (ch == '\n' || ch == '\r') ch = ' ';
+  return t.empty() ? "NONE" : t;
+}
+
+void put_ids(std::string* s, const std::array<std::string, 5>& id) {
+  for (const std::string& l : id) put_text(s, "%-80s\n", text_field(l, 80).c_str());
+}
+
+/// Values in lines of 3.
+void put_values(std::string* s, const std::vector<double>& v) {
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    put_real(s, v[k]);
+    if (k % 3 == 2 || k + 1 == v.size()) *s += '\n';
+  }
+}
+
+void put_axis(std::string* s, const UffAxis& a) {
+  put_text(s, "%10d%5d%5d%5d %-20s %-20s\n", a.data_type, a.length_exp, a.force_exp, a.temperature_exp,
+           text_field(a.label, 20).c_str(), text_field(a.unit, 20).c_str());
+}
+
+void put_le_double(std::string* s, double v) {
+  std::uint64_t u;
+  std::memcpy(&u, &v, 8);
+  for (int k = 0; k < 8; ++k) s->push_back(static_cast<char>((u >> (8 * k)) & 0xFF));
+}
+
+}  // namespace
+
+std::string format_uff58(const Uff58& d) {
+  const auto n = d.y.size();
+  if (n < 1) throw InputError("UFF 58 '" + d.id[0] + "': no points to write");
+  if (!d.even && d.x.size() != n)
+    throw InputError("UFF 58 '" + d.id[0] + "': uneven abscissa needs one x per point");
+  Uff58 w = d;
+  w.ordinate_type = d.is_complex() ? 6 : 4;  // dynid writes double precision
+  std::vector<double> v;
+  v.reserve(static_cast<std::size_t>(n * values_per_point(w)));
+  for (Eigen::Index k = 0; k < n; ++k) {
+    if (!w.even) v.push_back(d.x[k]);
+    v.push_back(d.y[k].real());
+    if (w.is_complex()) v.push_back(d.y[k].imag());
+  }
+  std::string s = d.binary ? "" : open_dataset(58);
+  if (d.binary) {
+    put_text(&s, "%6d\n", -1);
+    put_text(&s, "%6db%6d%6d%12d%12lld%6d%6d%12d%12d\n", 58, 1, 2, 11, static_cast<long long>(v.size() * 8), 0, 0, 0, 0);
+  }
+  put_ids(&s, d.id);
+  put_text(&s, "%5d%10d%5d%10d %-10s%10d%4d %-10s%10d%4d\n", d.function_type, d.function_id, d.version, d.load_case,
+           text_field(d.response_name, 10).c_str(), d.response_node, d.response_direction,
+           text_field(d.reference_name, 10).c_str(), d.reference_node, d.reference_direction);
+  put_text(&s, "%10d%10lld%10d", w.ordinate_type, static_cast<long long>(n), w.even ? 1 : 0);
+  put_real(&s, w.even ? d.x_min : 0.0);
+  put_real(&s, w.even ? d.dx : 0.0);
+  put_real(&s, d.z_value);
+  s += '\n';
+  put_axis(&s, d.abscissa);
+  put_axis(&s, d.ordinate);
+  put_axis(&s, d.denominator);
+  put_axis(&s, d.z_axis);
+  if (d.binary)
+    for (double x : v) put_le_double(&s, x);
+  else
+    put_values(&s, v);
+  put_text(&s, "%6d\n", -1);
+  return s;
+}
+
+std::string format_uff55(const Uff55& d) {
+  if (d.values.rows() != static_cast<Eigen::Index>(d.nodes.size()) || d.values.cols() != d.values_per_node)
+    throw InputError("UFF 55 '" + d.id[0] + "': values must be nodes x values per node");
+  std::string s = open_dataset(55);
+  put_ids(&s, d.id);
+  put_text(&s, "%10d%10d%10d%10d%10d%10d\n", d.model_type, d.analysis_type, d.data_characteristic, d.data_type_code,
+           d.complex ? 5 : 2, d.values_per_node);
+  for (int i : d.record7) put_text(&s, "%10d", i);
+  s += '\n';
+  for (double r : d.record8) put_real(&s, r);
+  s += '\n';
+  for (std::size_t i = 0; i < d.nodes.size(); ++i) {
+    put_text(&s, "%10d\n", d.nodes[i]);
+    std::vector<double> v;
+    for (int j = 0; j < d.values_per_node; ++j) {
+      v.push_back(d.values(static_cast<Eigen::Index>(i), j).real());
+      if (d.complex) v.push_back(d.values(static_cast<Eigen::Index>(i), j).imag());
+    }
+    put_values(&s, v);
+  }
+  put_text(&s, "%6d\n", -1);
+  return s;
+}
+
+std::string format_uff15(const UffNodes& d) {
+  std::string s = open_dataset(15);
+  for (const UffNode& n : d.nodes) {
+    put_text(&s, "%10d%10d%10d%10d", n.id, n.definition_cs, n.displacement_cs, n.colour);
+    for (int k = 0; k < 3; ++k) put_real(&s, n.x[k]);
+    s += '\n';
+  }
+  put_text(&s, "%6d\n", -1);
+  return s;
+}
+
+std::string format_uff164(const UffUnits& u) {
+  std::string s = open_dataset(164);
+  put_text(&s, "%10d%-20s%10d\n", u.code, text_field(u.description, 20).c_str(), u.temperature_mode);
+  put_real(&s, u.length);
+  put_real(&s, u.force);
+  put_real(&s, u.temperature);
+  s += '\n';
+  put_real(&s, u.temperature_offset);
+  s += '\n';
+  put_text(&s, "%6d\n", -1);
+  return s;
+}
+
+void write_uff(const std::string& path, const std::vector<UffDataset>& datasets, bool overwrite) {
+  std::string s;
+  for (const UffDataset& d : datasets) {
+    if (const auto* p = std::get_if<Uff58>(&d.data)) s += format_uff58(*p);
+    else if (const auto* q = std::get_if<Uff55>(&d.data)) s += format_uff55(*q);
+    else if (const auto* r = std::get_if<UffNodes>(&d.data)) s += format_uff15(*r);
+    else if (const auto* u = std::get_if<UffUnits>(&d.data)) s += format_uff164(*u);
+    else throw InputError(path + ": dynid cannot write UFF dataset " + std::to_string(d.type));
+  }
+  write_file_atomic(path, s, overwrite);
+}
+
+std::string uff_function_type_name(int t) {
+  static const char* names[] = {"general",         "time response",     "auto spectrum",       "cross spectrum",
+                                "FRF",             "transmissibility",  "coherence",           "auto correlation",
+                                "cross correlation", "PSD",             "ESD",                 "probability density",
+                                "spectrum",        "cumulative frequency distribution", "peaks valley", "stress/cycles",
+                                "strain/cycles",   "orbit",             "mode indicator function", "force pattern",
+                                "partial power",   "partial coherence", "eigenvalue",          "eigenvector",
+                                "shock response spectrum", "finite impulse response filter", "multiple coherence",
+                                "order function"};
+  return t >= 0 && t < static_cast<int>(std::size(names)) ? names[t] : "type " + std::to_string(t);
+}
+
+std::string uff_data_type_name(int t) {
+  static const std::map<int, const char*> names = {
+      {0, "unknown"},        {1, "general"},      {2, "stress"},          {3, "strain"},   {5, "temperature"},
+      {6, "heat flux"},      {8, "displacement"}, {9, "reaction force"},  {11, "velocity"}, {12, "acceleration"},
+      {13, "excitation force"}, {15, "pressure"}, {16, "mass"},           {17, "time"},     {18, "frequency"},
+      {19, "rpm"},           {20, "order"},       {21, "sound pressure"}, {22, "sound intensity"}, {23, "sound power"}};
+  const auto it = names.find(t);
+  return it != names.end() ? it->second : "type " + std::to_string(t);
+}
+
+// ---- conversions ----------------------------------------------------------------------------------------------
+
+namespace {
+
+struct Located {
+  const Uff58* d;
+  int line;
+};
+
+std::vector<Located> functions_of_type(const UffFile& f, int type) {
+  std::vector<Located> out;
+  for (const UffDataset& ds : f.datasets)
+    if (const auto* p = std::get_if<Uff58>(&ds.data))
+      if (p->function_type == type) out.push_back({p, ds.first_line});
+  return out;
+}
+
+std::string at(const UffFile& f, int line) { return f.source + ": dataset 58 starting at line " + std::to_string(line); }
+
+/// The DOF of a UFF node/direction pair and the sign that makes it positive.
+MeasuredDof uff_dof(int node, int direction, double* sign) {
+  MeasuredDof m;
+  m.node = node;
+  *sign = direction < 0 ? -1.0 : 1.0;
+  if (direction != 0) m.dof = static_cast<Dof>(std::abs(direction) - 1);
+  return m;
+}
+
+int uff_direction(const MeasuredDof& m) { return static_cast<int>(m.dof) + 1; }
+
+Quantity quantity_of(int data_type) {
+  switch (data_type) {
+    case 8: return Quantity::kDisplacement;
+    case 11: return Quantity::kVelocity;
+    case 12: return Quantity::kAcceleration;
+    case 9:
+    case 13: return Quantity::kForce;
+    default: return Quantity::kOther;
+  }
+}
+
+int data_type_of(const Channel& c) {
+  switch (c.quantity) {
+    case Quantity::kDisplacement: return 8;
+    case Quantity::kVelocity: return 11;
+    case Quantity::kAcceleration: return 12;
+    case Quantity::kForce: return c.input ? 13 : 9;
+    case Quantity::kOther: return 1;
+  }
+  return 1;
+}
+
+std::string unit_of(const std::string& label) { return label == "NONE" ? "" : label; }
+
+Channel response_channel(const Uff58& d, double* sign) {
+  Channel c;
+  c.dof = uff_dof(d.response_node, d.response_direction, sign);
+  c.quantity = quantity_of(d.ordinate.data_type);
+  c.input = d.ordinate.data_type == 13;
+  c.unit = unit_of(d.ordinate.unit);
+  c.name = d.id[0] != "NONE" && !d.id[0].empty() ? d.id[0] : d.response_name != "NONE" ? d.response_name : "";
+  return c;
+}
+
+void require_same_grid(const UffFile& f, const Located& a, const Located& b, const char* what) {
+  bool same = a.d->x.size() == b.d->x.size();
+  for (Eigen::Index k = 0; same && k < a.d->x.size(); ++k)
+    same = std::abs(a.d->x[k] - b.d->x[k]) <= 1e-9 * std::max(std::abs(a.d->x[k]), std::abs(b.d->x[k]));
+  if (!same)
+    throw InputError(at(f, b.line) + ": its " + what + " (" + std::to_string(b.d->x.size()) +
+                     " points) differs from that of the dataset at line " + std::to_string(a.line) + " (" +
+                     std::to_string(a.d->x.size()) + " points); dynid needs one common " + what);
+}
+
+Uff58 function_base(int type, const std::string& name, const MeasuredDof& rsp, int ref_node, int ref_dir) {
+  Uff58 d;
+  d.function_type = type;
+  d.id[0] = name.empty() ? "NONE" : name;
+  d.response_name = name.empty() ? "NONE" : name.substr(0, 10);
+  d.response_node = rsp.node;
+  d.response_direction = uff_direction(rsp);
+  d.reference_node = ref_node;
+  d.reference_direction = ref_dir;
+  return d;
+}
+
+UffAxis axis(int type, const std::string& label, const std::string& unit) {
+  UffAxis a;
+  a.data_type = type;
+  a.label = label;
+  a.unit = unit.empty() ? "NONE" : unit;
+  return a;
+}
+
+/// Even spacing if x_k == x_0 + k dx reproduces every abscissa exactly, else uneven.
+void set_abscissa(Uff58* d, const Eigen::VectorXd& x) {
+  d->x = x;
+  d->x_min = x[0];
+  d->dx = x.size() > 1 ? x[1] - x[0] : 1.0;
+  d->even = d->dx > 0;
+  for (Eigen::Index k = 0; d->even && k < x.size(); ++k) d->even = even_abscissa(d->x_min, d->dx, k) == x[k];
+}
+
+UffDataset dataset58(Uff58 d) {
+  UffDataset ds;
+  ds.type = 58;
+  ds.data = std::move(d);
+  return ds;
+}
+
+}  // namespace
+
+Recording uff_recording(const UffFile& f) {
+  const std::vector<Located> t = functions_of_type(f, 1);
+  if (t.empty()) throw InputError(f.source + ": no time responses (dataset 58 with function type 1)");
+  Recording r;
+  r.source = f.source;
+  using Key = std::tuple<int, int, std::string>;
+  std::map<Key, int> seen;  // occurrences of each channel: the n-th occurrence belongs to record n
+  std::vector<std::vector<std::pair<Key, const Located*>>> recs;
+  for (const Located& l : t) {
+    if (!l.d->even)
+      throw InputError(at(f, l.line) + ": time response with uneven abscissa; dynid needs evenly sampled data");
+    if (l.d->is_complex()) throw InputError(at(f, l.line) + ": time response with complex values");
+    require_same_grid(f, t[0], l, "sampling (start, interval and length)");
+    const Key key{l.d->response_node, std::abs(l.d->response_direction), l.d->id[0] + "|" + l.d->response_name};
+    const int rec = seen[key]++;
+    if (rec >= static_cast<int>(recs.size())) recs.resize(static_cast<std::size_t>(rec) + 1);
+    recs[static_cast<std::size_t>(rec)].push_back({key, &l});
+  }
+  const std::size_t nc = recs[0].size();
+  std::vector<double> sign(nc);
+  for (std::size_t c = 0; c < nc; ++c) r.channels.push_back(response_channel(*recs[0][c].second->d, &sign[c]));
+  const Eigen::Index ns = t[0].d->y.size();
+  for (std::size_t k = 0; k < recs.size(); ++k) {
+    if (recs[k].size() != nc)
+      throw InputError(f.source + ": record " + std::to_string(k + 1) + " has " + std::to_string(recs[k].size()) +
+                       " channels, the first has " + std::to_string(nc) + " (channel repeated at line " +
+                       std::to_string(recs[k][0].second->line) + "); every record needs the same channels");
+    Eigen::MatrixXd m(ns, static_cast<Eigen::Index>(nc));
+    for (std::size_t c = 0; c < nc; ++c) {
+      if (recs[k][c].first != recs[0][c].first)
+        throw InputError(at(f, recs[k][c].second->line) + ": record " + std::to_string(k + 1) +
+                         " lists its channels in another order than record 1");
+      m.col(static_cast<Eigen::Index>(c)) = sign[c] * recs[k][c].second->d->y.real();
+    }
+    r.records.push_back(std::move(m));
+  }
+  r.sample_rate_hz = 1.0 / t[0].d->dx;
+  r.validate(f.source);
+  return r;
+}
+
+FrfData uff_frf(const UffFile& f) {
+  const std::vector<Located> t = functions_of_type(f, 4);
+  if (t.empty()) throw InputError(f.source + ": no FRFs (dataset 58 with function type 4)");
+  FrfData h;
+  h.source = f.source;
+  auto index_of = [](std::vector<Channel>& list, const Channel& c) {
+    for (std::size_t k = 0; k < list.size(); ++k)
+      if (list[k].dof == c.dof) return static_cast<int>(k);
+    list.push_back(c);
+    return static_cast<int>(list.size()) - 1;
+  };
+  struct Entry {
+    int o, i;
+    std::complex<double> sign;
+    const Located* l;
+  };
+  std::vector<Entry> entries;
+  for (const Located& l : t) {
+    require_same_grid(f, t[0], l, "frequency grid");
+    double so = 1, si = 1;
+    Channel out = response_channel(*l.d, &so);
+    out.input = false;
+    Channel in;
+    in.dof = uff_dof(l.d->reference_node, l.d->reference_direction, &si);
+    in.quantity = Quantity::kForce;
+    in.input = true;
+    in.unit = unit_of(l.d->denominator.unit);
+    in.name = l.d->reference_name != "NONE" ? l.d->reference_name : "";
+    entries.push_back({index_of(h.outputs, out), index_of(h.inputs, in), so * si, &l});
+  }
+  const int no = h.num_outputs(), ni = h.num_inputs();
+  const Eigen::Index nf = t[0].d->x.size();
+  h.frequency_hz = t[0].d->x;
+  h.H.setZero(nf, no * ni);
+  std::vector<int> from(static_cast<std::size_t>(no * ni), 0);
+  for (const Entry& e : entries) {
+    int& line = from[static_cast<std::size_t>(e.o + e.i * no)];
+    if (line != 0)
+      throw InputError(at(f, e.l->line) + ": FRF " + to_string(h.outputs[e.o].dof) + "/" + to_string(h.inputs[e.i].dof) +
+                       " already given by the dataset at line " + std::to_string(line));
+    line = e.l->line;
+    h.H.col(e.o + e.i * no) = e.sign * e.l->d->y;
+  }
+  std::string missing;
+  for (int i = 0; i < ni; ++i)
+    for (int o = 0; o < no; ++o)
+      if (from[static_cast<std::size_t>(o + i * no)] == 0)
+        missing += (missing.empty() ? "" : ", ") + to_string(h.outputs[o].dof) + "/" + to_string(h.inputs[i].dof);
+  if (!missing.empty())
+    throw InputError(f.source + ": missing FRFs for output/input pairs " + missing +
+                     " (every response DOF needs an FRF for every reference DOF)");
+  // Coherence in the FRF layout: ordinary coherence (type 6) per output/input pair, or multiple coherence (26)
+  // per output repeated over the inputs; kept only if every FRF has one on the same grid.
+  Eigen::MatrixXd c = Eigen::MatrixXd::Constant(nf, static_cast<Eigen::Index>(no) * ni, std::numeric_limits<double>::quiet_NaN());
+  for (int type : {26, 6})
+    for (const Located& l : functions_of_type(f, type)) {
+      double s = 1;
+      const MeasuredDof d = uff_dof(l.d->response_node, l.d->response_direction, &s);
+      if (l.d->x.size() != nf) continue;
+      for (int o = 0; o < no; ++o) {
+        if (!(h.outputs[o].dof == d)) continue;
+        for (int i = 0; i < ni; ++i) {
+          if (type == 6 && !(h.inputs[i].dof == uff_dof(l.d->reference_node, l.d->reference_direction, &s))) continue;
+          c.col(o + i * no) = l.d->y.real();
+        }
+      }
+    }
+  if (c.allFinite()) h.coherence = c;
+  h.validate(f.source);
+  return h;
+}
+
+ModalData uff_modal_data(const UffFile& f) {
+  std::vector<const Uff55*> modes;
+  for (const UffDataset& ds : f.datasets)
+    if (const auto* p = std::get_if<Uff55>(&ds.data))
+      if (p->analysis_type == 2 || p->analysis_type == 3 || p->analysis_type == 7) modes.push_back(p);
+  if (modes.empty()) throw InputError(f.source + ": no modes (dataset 55 with analysis type 2, 3 or 7)");
+  std::vector<int> nodes;
+  std::map<int, int> row_of;
+  for (const Uff55* m : modes)
+    for (int n : m->nodes)
+      if (row_of.emplace(n, static_cast<int>(nodes.size())).second) nodes.push_back(n);
+  const auto nm = static_cast<Eigen::Index>(modes.size());
+  Eigen::MatrixXd all = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nodes.size()) * kNumDofTypes, nm);
+  ModalData out;
+  out.source = f.source;
+  out.frequencies_hz.resize(nm);
+  out.damping_ratios.resize(nm);
+  for (Eigen::Index k = 0; k < nm; ++k) {
+    const Uff55& m = *modes[static_cast<std::size_t>(k)];
+    std::complex<double> rot = 1.0;
+    if (m.complex && m.values.size() > 0) {
+      Eigen::Index i, j;
+      m.values.cwiseAbs().maxCoeff(&i, &j);
+      if (std::abs(m.values(i, j)) > 0) rot = std::conj(m.values(i, j)) / std::abs(m.values(i, j));
+    }
+    for (std::size_t n = 0; n < m.nodes.size(); ++n)
+      for (int j = 0; j < std::min(m.values_per_node, kNumDofTypes); ++j)
+        all(row_of[m.nodes[n]] * kNumDofTypes + j, k) = (rot * m.values(static_cast<Eigen::Index>(n), j)).real();
+    out.frequencies_hz[k] = m.frequency_hz();
+    out.damping_ratios[k] = m.damping_ratio();
+  }
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index r = 0; r < all.rows(); ++r)
+    if ((all.row(r).array() != 0.0).any()) {
+      keep.push_back(r);
+      out.dofs.push_back({nodes[static_cast<std::size_t>(r / kNumDofTypes)], static_cast<Dof>(r % kNumDofTypes)});
+    }
+  out.shapes.resize(static_cast<Eigen::Index>(keep.size()), nm);
+  for (std::size_t r = 0; r < keep.size(); ++r) out.shapes.row(static_cast<Eigen::Index>(r)) = all.row(keep[r]);
+  if ((out.damping_ratios.array() == 0.0).all()) out.damping_ratios.resize(0);
+  out.validate(f.source);
+  return out;
+}
+
+std::vector<UffDataset> uff_datasets(const Recording& r, bool binary) {
+  r.validate("recording " + r.source);
+  std::vector<UffDataset> out;
+  for (std::size_t k = 0; k < r.records.size(); ++k)
+    for (int c = 0; c < r.num_channels(); ++c) {
+      const Channel& ch = r.channels[static_cast<std::size_t>(c)];
+      Uff58 d = function_base(1, ch.name, ch.dof, 0, 0);
+      d.load_case = static_cast<int>(k) + 1;
+      d.binary = binary;
+      d.ordinate_type = 4;
+      d.even = true;
+      d.x_min = 0;
+      d.dx = 1.0 / r.sample_rate_hz;
+      d.abscissa = axis(17, "Time", "s");
+      d.ordinate = axis(data_type_of(ch), to_string(ch.quantity), ch.unit);
+      const Eigen::VectorXd y = r.records[k].col(c);
+      d.y = y.cast<std::complex<double>>();
+      d.x.resize(y.size());
+      for (Eigen::Index i = 0; i < y.size(); ++i) d.x[i] = even_abscissa(0.0, d.dx, i);
+      out.push_back(dataset58(std::move(d)));
+    }
+  return out;
+}
+
+std::vector<UffDataset> uff_datasets(const FrfData& h, bool binary) {
+  h.validate("FRFs " + h.source);
+  std::vector<UffDataset> out;
+  for (int i = 0; i < h.num_inputs(); ++i)
+    for (int o = 0; o < h.num_outputs(); ++o) {
+      const Channel& oc = h.outputs[static_cast<std::size_t>(o)];
+      const Channel& ic = h.inputs[static_cast<std::size_t>(i)];
+      Uff58 d = function_base(4, oc.name, oc.dof, ic.dof.node, uff_direction(ic.dof));
+      d.reference_name = ic.name.empty() ? "NONE" : ic.name.substr(0, 10);
+      d.binary = binary;
+      d.ordinate_type = 6;
+      set_abscissa(&d, h.frequency_hz);
+      d.abscissa = axis(18, "Frequency", "Hz");
+      d.ordinate = axis(data_type_of(oc), to_string(oc.quantity), oc.unit);
+      d.denominator = axis(13, "force", ic.unit);
+      d.y = h.H.col(o + i * h.num_outputs());
+      out.push_back(dataset58(std::move(d)));
+    }
+  if (h.coherence.size())
+    for (int i = 0; i < h.num_inputs(); ++i)
+      for (int o = 0; o < h.num_outputs(); ++o) {
+        const Channel& oc = h.outputs[static_cast<std::size_t>(o)];
+        const Channel& ic = h.inputs[static_cast<std::size_t>(i)];
+        Uff58 d = function_base(6, oc.name, oc.dof, ic.dof.node, uff_direction(ic.dof));
+        d.binary = binary;
+        d.ordinate_type = 4;
+        set_abscissa(&d, h.frequency_hz);
+        d.abscissa = axis(18, "Frequency", "Hz");
+        d.ordinate = axis(0, "coherence", "");
+        d.y = h.coherence.col(o + i * h.num_outputs()).cast<std::complex<double>>();
+        out.push_back(dataset58(std::move(d)));
+      }
+  return out;
+}
+
+std::vector<UffDataset> uff_datasets(const ModalData& m) {
+  m.validate("modal data " + m.source);
+  std::vector<int> nodes;
+  std::map<int, int> row_of;
+  bool rotations = false;
+  for (const MeasuredDof& d : m.dofs) {
+    if (row_of.emplace(d.node, static_cast<int>(nodes.size())).second) nodes.push_back(d.node);
+    rotations = rotations || is_rotation(d.dof);
+  }
+  const int per = rotations ? 6 : 3;
+  std::vector<UffDataset> out;
+  for (int k = 0; k < m.num_modes(); ++k) {
+    Uff55 d;
+    d.id[0] = "Mode " + std::to_string(k + 1);
+    d.data_characteristic = rotations ? 3 : 2;
+    d.values_per_node = per;
+    d.record7 = {2, 4, 1, k + 1};
+    d.record8 = {m.frequencies_hz[k], 0.0, m.damping_ratios.size() > k ? m.damping_ratios[k] : 0.0, 0.0};
+    d.nodes = nodes;
+    d.values = Eigen::MatrixXcd::Zero(static_cast<Eigen::Index>(nodes.size()), per);
+    for (std::size_t r = 0; r < m.dofs.size(); ++r)
+      d.values(row_of[m.dofs[r].node], static_cast<int>(m.dofs[r].dof)) = m.shapes(static_cast<Eigen::Index>(r), k);
+    UffDataset ds;
+    ds.type = 55;
+    ds.data = std::move(d);
+    out.push_back(std::move(ds));
+  }
+  return out;
+}
+
+void write_uff58_recording(const std::string& path, const Recording& r, bool binary, bool overwrite) {
+  write_uff(path, uff_datasets(r, binary), overwrite);
+}
+
+void write_uff58_frf(const std::string& path, const FrfData& h, bool binary, bool overwrite) {
+  write_uff(path, uff_datasets(h, binary), overwrite);
+}
+
+void write_uff55(const std::string& path, const ModalData& m, bool overwrite) {
+  write_uff(path, uff_datasets(m), overwrite);
+}
+
+}  // namespace dynid
