@@ -145,3 +145,57 @@ write("fuzz_case", "deep.yaml", "a: " + "[" * 3000 + "]" * 3000 + "\n")
 write("fuzz_case", "anchors.yaml", "a: &a [1, 2]\nb: &b [*a, *a, *a]\nc: [*b, *b, *b]\nmodel: *a\n")
 write("fuzz_case", "mesh-device.yaml", "model:\n  file: /dev/zero\n")
 write("fuzz_case", "garbage.yaml", garbage)
+
+# --- UFF, text tables, LabVIEW (samples from ../shared/data when present: heads cut at a line break) ---
+shared = os.path.join(os.path.dirname(root), "shared", "data")
+
+
+def head(path, n=6000):
+    with open(path, "rb") as f:
+        data = f.read(n)
+    return data[: data.rfind(b"\n") + 1] if len(data) == n else data
+
+
+uffs = os.path.join(shared, "uff-samples")
+for name in ["binary8byte.uff", "TestLab 161 164 18 15 82.uff", "mesh_Oros-modal_uff15_uff2412.uff",
+             "Sample_UFF58_ascii.uff", "Sample_UFF58b_bin.uff"]:
+    p = os.path.join(uffs, name)
+    if os.path.exists(p):
+        data = head(p, 12000) if name.startswith("Sample") else read(p)
+        variants("fuzz_uff", name.replace(" ", "-"), data)
+write("fuzz_uff", "truncated-58.uff", read("tests/data/bad/truncated-58.uff"))
+b8 = os.path.join(uffs, "binary8byte.uff")
+if os.path.exists(b8):
+    data = read(b8)
+    # record 1 of 58b: "58b  byte-order  format  lines  bytes ..."; declare huge sizes and the other byte order
+    i = data.index(b"58b")
+    j = data.index(b"\n", i)
+    write("fuzz_uff", "58b-other-byte-order.uff", data[:i] + b"58b     2" + data[i + 9:])
+    write("fuzz_uff", "58b-huge-bytes.uff", data[:i] + b"58b     1     2          11  9999999999     0     0           0           0" + data[j - 1 if data[j - 1:j] == b"\r" else j:])
+    k = data.index(b"       250")
+    write("fuzz_uff", "58b-huge-points.uff", data[:k] + b"2000000000" + data[k + 10:])
+write("fuzz_uff", "garbage.uff", garbage)
+write("fuzz_uff", "delimiters.uff", "    -1\n    -1\n    -1\n    58\n    -1\n")
+
+tit = os.path.join(shared, "real", "tool-impact-test")
+for name in ["frf_point_1.txt", "impact_point1_time.txt"]:
+    p = os.path.join(tit, name)
+    if os.path.exists(p):
+        variants("fuzz_text_table", name, head(p, 3000))
+write("fuzz_text_table", "header.csv", "# comment\ntime,force,acc1\n0,1,2\n0.01,1.5,2e-3\n0.02,-1,nan\n")
+write("fuzz_text_table", "ragged.csv", "t a\n0 1\n1 2 3\n2\n")
+write("fuzz_text_table", "uneven.txt", "0 1\n1 1\n1.5 1\n4 1\n")
+write("fuzz_text_table", "big-numbers.txt", "1e999 -1e999\n1e-999 0x1p3\ninf nan\n")
+write("fuzz_text_table", "garbage.csv", garbage)
+
+usc = os.path.join(shared, "real", "usc-cantilever-ds4")
+for name in ["FFT_data.lvm", "data_set_1_downsampled_by_16.lvm"]:
+    p = os.path.join(usc, name)
+    if os.path.exists(p):
+        data = head(p, 3000)
+        variants("fuzz_lvm", name, data)
+        write("fuzz_lvm", "samples-huge-" + name, data.replace(b"Samples\t150000", b"Samples\t999999999999"))
+        write("fuzz_lvm", "channels-huge-" + name, data.replace(b"Channels\t1", b"Channels\t2147483647"))
+write("fuzz_lvm", "no-x.lvm", "LabVIEW Measurement\t\nX_Columns\tNo\n***End_of_Header***\t\n\nChannels\t2\t\t\n"
+      "Samples\t3\t3\t\nDelta_X\t0.1\t0.1\t\n***End_of_Header***\t\t\nA\tB\n1\t2\n3\t4\n5\t6\n")
+write("fuzz_lvm", "garbage.lvm", b"LabVIEW Measurement\n" + garbage)

@@ -8,6 +8,7 @@
 #include "dynid/io/matrix_market.hpp"
 #include "dynid/io/mesh_files.hpp"
 #include "dynid/io/modal_data_io.hpp"
+#include "dynid/io/uff.hpp"
 #include "test_util.hpp"
 
 namespace dynid {
@@ -89,6 +90,14 @@ TEST(HostileInputs, GeneratorOfEveryKindParses) {
                            "  sections: {s: {A: 1e-2, Iy: 1e-4, Iz: 1e-4, J: 1e-6, I: 1e-4}}\n  generate:\n";
   EXPECT_EQ(parse_case(head + "    beam: {elements: 4, material: steel, section: s}\n", "b.yaml").model.elements().size(), 4u);
   EXPECT_EQ(parse_case(head + "    frame3d: {material: steel, column: s, beam: s}\n", "f.yaml").model.elements().size(), 8u);
+}
+
+TEST(HostileInputs, UffOrdinateTypeOutOfIntRange) {
+  // fuzz_uff under UBSan: record 7's data type 4.2e10 was cast to int before it was checked.
+  const std::string e =
+      ErrorOf([] { parse_uff(Hostile("uff58b-type-out-of-range.uff"), "uff58b-type-out-of-range.uff"); });
+  EXPECT_HAS(e, "uff58b-type-out-of-range.uff");
+  EXPECT_HAS(e, "ordinate data type must be 2 (real single), 4 (real double), 5 (complex single) or 6 (complex double)");
 }
 
 }  // namespace
