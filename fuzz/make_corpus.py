@@ -5,6 +5,7 @@ anywhere; it rewrites the seeds it makes and leaves files the fuzzer added (scri
 import glob
 import os
 import random
+import re
 import struct
 
 here = os.path.dirname(os.path.abspath(__file__))
@@ -57,46 +58,14 @@ write("fuzz_gmsh", "garbage-after-format.msh", b"$MeshFormat\n2.2 1 8\n" + garba
 # --- Abaqus ---
 inp = read("cases/paper-frame-abaqus/frame.inp")
 variants("fuzz_abaqus", "paper-frame.inp", inp)
-write("fuzz_abaqus", "space-frame.inp", """** a two-member space frame
-*heading
-test
-*Node, nset=all
-1, 0., 0., 0.
-2, 0., 0., 3.
-3, 4., 0., 3.
-*Element, type=B31, elset=girders
-2, 2,
- 3
-*Element, type=B33, elset=posts
-1, 1, 2
-*Elset, elset=posts, generate
-1, 1, 1
-*ELSET, ELSET=Everything
-posts, girders
-*Material, name=Steel
-*Elastic
-2.1e11, 0.3
-*Density
-7850.
-*Beam Section, elset=POSTS, material=steel, section=RECT
-0.2, 0.4
-1., 0., 0.
-*BEAM SECTION, ELSET=girders, MATERIAL=STEEL,
- SECTION=CIRC
-0.05
-0., 0., 1.
-*BEAM GENERAL SECTION, ELSET=x, SECTION=GENERAL, DENSITY=7850
-0.01, 1e-4, 0, 1e-4, 1e-5
-0., 0., 1.
-2.1e11, 8e10
-*BOUNDARY
-1, 1, 6
-2, ENCASTRE
-*Element, type=S4R, elset=shells
-9, 1, 2, 3, 1
-*STEP
-*END STEP
-""")
+# The unit tests' space frame (tests/test_mesh_files.cpp, kSpaceFrame) with its *INCLUDE expanded (refused when
+# parsing from memory), and a *BEAM GENERAL SECTION added.
+test_src = read("tests/test_mesh_files.cpp").decode()
+space = re.search(r'kSpaceFrame = R"\((.*?)\)"', test_src, re.S).group(1)
+members = re.search(r'Write\("members.inp", "(.*?)"\)', test_src).group(1).replace("\\n", "\n")
+space = space.replace("*INCLUDE, INPUT=members.inp\n", members)
+write("fuzz_abaqus", "space-frame.inp", space + "*BEAM GENERAL SECTION, ELSET=x, SECTION=GENERAL, DENSITY=7850\n"
+      "0.01, 1e-4, 0, 1e-4, 1e-5\n0., 0., 1.\n2.1e11, 8e10\n*BOUNDARY\n2, ENCASTRE\n*STEP\n*END STEP\n")
 write("fuzz_abaqus", "generate-huge.inp", "*NODE\n1, 0, 0\n*NSET, NSET=A, GENERATE\n1, 2000000000, 1\n"
       "*ELSET, ELSET=B, GENERATE\n-2147483648, 2147483647, 1\n")
 write("fuzz_abaqus", "include.inp", "*INCLUDE, INPUT=/dev/zero\n")

@@ -1,13 +1,19 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (fuzz/, clang, ASan + UBSan) in ./build-fuzz (override with DYNID_FUZZ_DIR) and
 # runs each on its seed corpus fuzz/corpus/<target>/ (read only; new inputs go to build-fuzz/corpus/<target>/).
-#   scripts/fuzz.sh [seconds] [runs]     per target: stop after `seconds` (default 60) or `runs` executions
+#   scripts/fuzz.sh [seconds] [runs] [target...]   per target: stop after `seconds` (default 60) or `runs`
+#                                                    executions (-1: no limit); default: every fuzz/fuzz_*.cpp
 # Prints the executions per target; exits non-zero on any finding (crash input in build-fuzz/artifacts/).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 build=${DYNID_FUZZ_DIR:-$here/build-fuzz}
 seconds=${1:-60}
 runs=${2:--1}
+shift $(($# < 2 ? $# : 2))
+targets=("$@")
+if ((${#targets[@]} == 0)); then
+  for src in "$here"/fuzz/fuzz_*.cpp; do targets+=("$(basename "$src" .cpp)"); done
+fi
 jobs=${DYNID_JOBS:-2}
 
 cmake -S "$here" -B "$build" -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug "-DCMAKE_CXX_FLAGS_DEBUG=-O1 -g" \
@@ -19,8 +25,7 @@ source "$here/scripts/sanitizer/options.sh"
 status=0
 summary=""
 mkdir -p "$build/artifacts"
-for src in "$here"/fuzz/fuzz_*.cpp; do
-  t=$(basename "$src" .cpp)
+for t in "${targets[@]}"; do
   mkdir -p "$build/corpus/$t"
   dict=()
   [ -f "$here/fuzz/$t.dict" ] && dict=("-dict=$here/fuzz/$t.dict")
