@@ -1,7 +1,7 @@
 // fuzz_case: the input is the text of a case file (YAML, with model, analysis, detect, update and test sections)
 // for parse_case. Its folder does not exist, so files it names by relative path (mesh, model and measured data
 // files) are not found: that is an InputError, and the fuzzer stays on the case file itself (the other readers
-// have their own targets). Under FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION `generate:` builds at most 2000 elements.
+// have their own targets). Under FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION `generate:` builds at most 200 elements.
 #include "dynid/io/case_file.hpp"
 #include "fuzz_reader.hpp"
 

@@ -58,6 +58,14 @@ TEST(HostileInputs, AbaqusIncludeOfADeviceIsRefused) {
              "dev.inp:3: *INCLUDE: *INCLUDE is not available when the file is read from memory");
 }
 
+TEST(HostileInputs, AbaqusGenerateRange) {
+  // fuzz_abaqus: a GENERATE line from -7144287 to 1 made a set of 7 x 10^6 ids (a timeout); ids are >= 1.
+  EXPECT_HAS(ErrorOf([] { parse_abaqus("*NODE\n1, 0, 0\n*ELSET, ELSET=B, GENERATE\n-7144287, 1\n", "g.inp"); }),
+             "g.inp:4: *ELSET, GENERATE: needs 1 <= first <= last and increment >= 1");
+  EXPECT_HAS(ErrorOf([] { parse_abaqus("*NSET, NSET=A, GENERATE\n1, 2000000000, 1\n", "g.inp"); }),
+             "g.inp:2: *NSET, GENERATE: more than 10000000 ids");
+}
+
 TEST(HostileInputs, CaseFileModelOfADeviceIsRefused) {
   const std::string e = ErrorOf([] { load_case("/dev/null"); });
   EXPECT_HAS(e, "/dev/null: not a regular file");
