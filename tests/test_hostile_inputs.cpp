@@ -63,7 +63,7 @@ TEST(HostileInputs, AbaqusGenerateRange) {
   EXPECT_HAS(ErrorOf([] { parse_abaqus("*NODE\n1, 0, 0\n*ELSET, ELSET=B, GENERATE\n-7144287, 1\n", "g.inp"); }),
              "g.inp:4: *ELSET, GENERATE: needs 1 <= first <= last and increment >= 1");
   EXPECT_HAS(ErrorOf([] { parse_abaqus("*NSET, NSET=A, GENERATE\n1, 2000000000, 1\n", "g.inp"); }),
-             "g.inp:2: *NSET, GENERATE: more than 10000000 ids");
+             "g.inp:2: *NSET, GENERATE: more than 10^7 ids");
 }
 
 TEST(HostileInputs, CaseFileModelOfADeviceIsRefused) {

@@ -45,8 +45,10 @@ namespace {
 /// resolve under the sanitizers).
 #ifdef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
 constexpr long long kMaxGeneratedIds = 100000;
+constexpr const char* kMaxGeneratedIdsText = "10^5";
 #else
 constexpr long long kMaxGeneratedIds = 10000000;
+constexpr const char* kMaxGeneratedIdsText = "10^7";
 #endif
 
 std::string upper(std::string s) {
@@ -255,7 +257,7 @@ class AbaqusReader {
         if (a < 1 || d < 1 || b < a)
           throw InputError(l.where + ": *" + c.name + ", GENERATE: needs 1 <= first <= last and increment >= 1");
         if ((static_cast<long long>(b) - a) / d >= kMaxGeneratedIds)
-          throw InputError(l.where + ": *" + c.name + ", GENERATE: more than " + std::to_string(kMaxGeneratedIds) + " ids");
+          throw InputError(l.where + ": *" + c.name + ", GENERATE: more than " + kMaxGeneratedIdsText + " ids");
         for (long long k = a; k <= b; k += d) ids.push_back(static_cast<int>(k));
         continue;
       }
