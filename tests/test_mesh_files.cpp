@@ -54,15 +54,7 @@ std::string GmshCase(const std::string& mesh) {
   return Replace(Slurp(test::CasesDir() + "/paper-frame-gmsh/case.yaml"), "file: frame.msh", "file: " + mesh);
 }
 
-template <class F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using test::ErrorOf;
 std::string MeshError(const std::string& path) {
   return ErrorOf([&] { read_mesh_file(path); });
 }

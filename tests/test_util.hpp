@@ -30,6 +30,17 @@ inline double Mac(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 /// product of their orthonormal bases): 0 when the spaces coincide.
 double SubspaceGap(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B);
 
+/// The message of the InputError that f() throws, or "(no error)".
+template <class F>
+std::string ErrorOf(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
 /// Folder of the repository's bundled cases and of ../shared (set by CMake).
 std::string CasesDir();
 std::string SharedDir();

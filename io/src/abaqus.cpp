@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "dynid/io/mesh_files.hpp"
+#include "dynid/io/limits.hpp"
 #include "dynid/mesh/error.hpp"
 #include "internal/file_util.hpp"
 #include "internal/sections.hpp"
@@ -50,6 +51,11 @@ std::string trim(const std::string& s) {
   if (a == std::string::npos) return "";
   return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
 }
+/// The folder holding `path` ("." for a bare file name), against which its *INCLUDEs resolve.
+std::string folder_of(const std::string& path) {
+  const fs::path parent = fs::path(path).parent_path();
+  return parent.empty() ? "." : parent.string();
+}
 std::vector<std::string> split(const std::string& s) {
   std::vector<std::string> f;
   std::stringstream ss(s);
@@ -80,24 +86,27 @@ struct Card {
 
 class AbaqusReader {
  public:
-  explicit AbaqusReader(const std::string& path) {
-    out_.file = path;
+  explicit AbaqusReader(const std::string& name) {
+    out_.file = name;
     out_.names_ignore_case = true;
   }
 
-  MeshData read() {
+  /// `bytes` is the file named `name`; its *INCLUDEs are read from `include_dir` ("": not allowed).
+  MeshData read(const std::string& bytes, const std::string& include_dir) {
     std::vector<Line> lines;
-    load(out_.file, 0, &lines);
+    load(bytes, out_.file, include_dir, 0, &lines);
     for (const Card& c : cards(lines)) card(c);
     finish();
     return std::move(out_);
   }
 
  private:
-  /// Reads a file's lines, expanding *INCLUDE, dropping comments and blank lines, joining continuations.
-  void load(const std::string& path, int depth, std::vector<Line>* lines) {
+  /// Splits a file's bytes into lines, expanding *INCLUDE (files in `dir`; "": none allowed), dropping comments
+  /// and blank lines, joining continuations.
+  void load(const std::string& bytes, const std::string& path, const std::string& dir, int depth,
+            std::vector<Line>* lines) {
     if (depth > 10) throw InputError(path + ": *INCLUDE nested more than 10 deep (a cycle?)");
-    std::istringstream in(internal::read_file_bytes(path));
+    std::istringstream in(bytes);
     int n = 0;
     bool continued = false;
     for (std::string raw; std::getline(in, raw);) {
@@ -109,9 +118,10 @@ class AbaqusReader {
         lines->back().text += t;
       } else if (upper(t).rfind("*INCLUDE", 0) == 0) {
         Card c = keyword(t, where);
-        const fs::path inc = fs::path(path).parent_path() / c.param("INPUT");
+        if (dir.empty()) c.fail("*INCLUDE is not available when the file is read from memory");
+        const fs::path inc = fs::path(dir) / c.param("INPUT");
         if (!fs::exists(inc)) c.fail("cannot open '" + inc.string() + "'");
-        load(inc.string(), depth + 1, lines);
+        load(internal::read_file_bytes(inc.string()), inc.string(), folder_of(inc.string()), depth + 1, lines);
         continue;
       } else {
         lines->push_back({t, where});
@@ -235,8 +245,11 @@ class AbaqusReader {
       if (c.has("GENERATE")) {
         if (f.size() < 2 || f.size() > 3) throw InputError(l.where + ": *" + c.name + ", GENERATE: expected 'first, last, increment'");
         const int a = integer(f[0], l, "first"), b = integer(f[1], l, "last"), d = f.size() == 3 ? integer(f[2], l, "increment") : 1;
-        if (d < 1 || b < a) throw InputError(l.where + ": *" + c.name + ", GENERATE: needs first <= last and increment >= 1");
-        if ((static_cast<long long>(b) - a) / d >= 10000000) throw InputError(l.where + ": *" + c.name + ", GENERATE: more than 10^7 ids");
+        if (a < 1 || d < 1 || b < a)
+          throw InputError(l.where + ": *" + c.name + ", GENERATE: needs 1 <= first <= last and increment >= 1");
+        const long long limit = reader_limits().max_generated_ids;  // dynid/io/limits.hpp
+        if ((static_cast<long long>(b) - a) / d >= limit)
+          throw InputError(l.where + ": *" + c.name + ", GENERATE: more than " + limit_text(double(limit)) + " ids");
         for (long long k = a; k <= b; k += d) ids.push_back(static_cast<int>(k));
         continue;
       }
@@ -424,6 +437,11 @@ class AbaqusReader {
 
 }  // namespace
 
-MeshData read_abaqus(const std::string& path) { return AbaqusReader(path).read(); }
+MeshData parse_abaqus(const std::string& bytes, const std::string& name, const std::string& include_dir) {
+  return AbaqusReader(name).read(bytes, include_dir);
+}
+MeshData read_abaqus(const std::string& path) {
+  return AbaqusReader(path).read(internal::read_file_bytes(path), folder_of(path));
+}
 
 }  // namespace dynid

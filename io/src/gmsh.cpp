@@ -429,6 +429,7 @@ class GmshReader {
 
 }  // namespace
 
-MeshData read_gmsh(const std::string& path) { return GmshReader(path, internal::read_file_bytes(path)).read(); }
+MeshData parse_gmsh(const std::string& bytes, const std::string& name) { return GmshReader(name, bytes).read(); }
+MeshData read_gmsh(const std::string& path) { return parse_gmsh(internal::read_file_bytes(path), path); }
 
 }  // namespace dynid

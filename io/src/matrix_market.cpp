@@ -1,15 +1,16 @@
 #include "dynid/io/matrix_market.hpp"
+#include "dynid/io/limits.hpp"
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 #include <vector>
 
 #include "dynid/io/output.hpp"
 #include "dynid/mesh/error.hpp"
+#include "internal/file_util.hpp"
 
 namespace dynid {
 
@@ -34,8 +35,11 @@ void write_matrix_market(const std::string& path, const SparseMatrix& A, bool sy
 }
 
 SparseMatrix read_matrix_market(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open for reading");
+  return parse_matrix_market(internal::read_file_bytes(path), path);
+}
+
+SparseMatrix parse_matrix_market(const std::string& text, const std::string& path) {
+  std::istringstream in(text);
   std::string line;
   long long lineno = 0;
   auto fail = [&](const std::string& what) -> void {
@@ -66,11 +70,17 @@ SparseMatrix read_matrix_market(const std::string& path) {
     break;
   }
   if (rows < 0) fail("missing size line 'rows cols entries'");
-  if (rows <= 0 || cols <= 0 || nnz < 0 || rows > 2147483647LL || cols > 2147483647LL)
-    fail("invalid sizes " + std::to_string(rows) + " x " + std::to_string(cols) + ", " + std::to_string(nnz) + " entries");
+  // The sparse matrix allocates per column whatever the entries, so the declared size must be bounded.
+  const long long max_dimension = reader_limits().max_matrix_dimension;  // dynid/io/limits.hpp
+  if (rows <= 0 || cols <= 0 || nnz < 0 || rows > max_dimension || cols > max_dimension)
+    fail("invalid sizes " + std::to_string(rows) + " x " + std::to_string(cols) + ", " + std::to_string(nnz) +
+         " entries (at most " + std::to_string(max_dimension) + " rows and columns)");
+  if (sym && rows != cols)
+    fail("a symmetric matrix must be square, not " + std::to_string(rows) + " x " + std::to_string(cols));
   if (nnz > rows * cols) fail("more entries (" + std::to_string(nnz) + ") than a " + std::to_string(rows) + " x " + std::to_string(cols) + " matrix holds");
   std::vector<Eigen::Triplet<double, int>> t;
-  t.reserve(static_cast<std::size_t>(std::min<long long>(nnz, 50000000LL)) * (sym ? 2 : 1));
+  // The declared count is not trusted for the allocation: an entry needs at least 6 bytes ("1 1 1\n").
+  t.reserve(static_cast<std::size_t>(std::min<long long>(nnz, static_cast<long long>(text.size() / 6))) * (sym ? 2 : 1));
   long long read = 0;
   while (read < nnz && std::getline(in, line)) {
     ++lineno;

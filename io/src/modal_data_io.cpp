@@ -47,6 +47,8 @@ ModalData parse_modal_data_json(const std::string& text, const std::string& name
     j = nlohmann::ordered_json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     throw InputError(name + ": not valid JSON (byte " + std::to_string(e.byte) + "): " + e.what());
+  } catch (const nlohmann::json::exception& e) {  // e.g. out_of_range: a number too large for a double
+    throw InputError(name + ": not valid JSON: " + e.what());
   }
   if (!j.is_object() || !j.contains("modes") || !j["modes"].is_array())
     throw InputError(name + ": expected an object with a \"modes\" list");

@@ -1,11 +1,13 @@
 // The `model:` section of a case file. See docs/case-file.md for the annotated reference.
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <regex>
 #include <set>
 
 #include "dynid/io/mesh_files.hpp"
+#include "dynid/io/limits.hpp"
 #include "dynid/mesh/generators.hpp"
 #include "internal/case_util.hpp"
 #include "internal/model_yaml.hpp"
@@ -405,7 +407,7 @@ struct Parser {
     ctx.require_map(g, "generate");
     if (g.size() != 1) fail(g, "generate: give exactly one of beam, frame2d, frame3d");
     const std::string kind = g.begin()->first.Scalar();
-    const YAML::Node& s = g.begin()->second;
+    const YAML::Node s = g.begin()->second;  // a copy: the iterator's pair is a temporary
     ctx.require_map(s, "generate." + kind);
     auto num = [&](const char* k, double def) { return s[k] ? ctx.number(s[k], kind + " " + k) : def; };
     auto integer = [&](const char* k, int def) {
@@ -427,6 +429,16 @@ struct Parser {
       f->beam = sec("beam");
       f->mass = model.mass_type();
     };
+    // The size a generator is asked for is checked before anything is allocated (in doubles: no overflow).
+    auto check_size = [&](double elements) {
+      // The largest model `generate:` builds, so that a case file cannot ask for more memory than a machine has
+      // (bench/ goes to 10^6 DOFs, about 3 x 10^5 elements): dynid/io/limits.hpp.
+      const double max_elements = reader_limits().max_generated_elements;
+      if (elements <= max_elements) return;
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%.4g elements; at most %.4g can be generated", elements, max_elements);
+      fail(s, "generate." + kind + ": " + buf);
+    };
     Model gen;
     if (kind == "beam") {
       ctx.only_keys(s, "generate.beam", {"length", "elements", "material", "section", "support"});
@@ -436,6 +448,7 @@ struct Parser {
       b.material = mat();
       b.section = sec("section");
       b.mass = model.mass_type();
+      check_size(b.elements);
       const std::string sup = s["support"] ? ctx.string(s["support"], "beam support") : "free";
       if (sup == "free") b.support = BeamSupport::Free;
       else if (sup == "cantilever") b.support = BeamSupport::Cantilever;
@@ -449,6 +462,7 @@ struct Parser {
       f.bays = integer("bays", 1);
       f.span = num("span", 1.0);
       members(&f);
+      check_size((2.0 * f.bays + 1) * f.stories * f.divisions);
       gen = make_frame2d(f);
     } else if (kind == "frame3d") {
       ctx.only_keys(s, "generate.frame3d", {"bays_x", "bays_y", "stories", "divisions", "span_x", "span_y", "height", "material", "column", "beam"});
@@ -458,6 +472,8 @@ struct Parser {
       f.span_x = num("span_x", 1.0);
       f.span_y = num("span_y", 1.0);
       members(&f);
+      const double bx = f.bays_x, by = f.bays_y;
+      check_size(((bx + 1) * (by + 1) + bx * (by + 1) + by * (bx + 1)) * f.stories * f.divisions);
       gen = make_frame3d(f);
     } else {
       fail(g.begin()->first, "generate: unknown generator '" + kind + "' (known: beam, frame2d, frame3d)");

@@ -16,6 +16,9 @@ namespace dynid {
 namespace fs = std::filesystem;
 
 std::string internal::read_file_bytes(const std::string& path) {
+  // Only regular files: a device (/dev/zero) or a FIFO named by a hostile input would never end.
+  std::error_code ec;
+  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec)) throw InputError(path + ": not a regular file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open for reading");
   std::ostringstream ss;

@@ -35,8 +35,7 @@ struct Rows {
   std::vector<int> line_of;
 };
 
-Rows read_rows(const std::string& path) {
-  const std::string bytes = internal::read_file_bytes(path);
+Rows parse_rows(const std::string& bytes, const std::string& path) {
   internal::LineReader in(bytes);
   Rows r;
   std::string_view l;
@@ -133,8 +132,11 @@ bool same_grid(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 
 }  // namespace
 
+TextTable parse_text_table(const std::string& text, const std::string& name, bool x_column) {
+  return to_table(parse_rows(text, name), name, x_column);
+}
 TextTable read_text_table(const std::string& path, bool x_column) {
-  return to_table(read_rows(path), path, x_column);
+  return parse_text_table(internal::read_file_bytes(path), path, x_column);
 }
 
 double check_even_steps(const Eigen::VectorXd& x, const std::vector<int>& line_of, const std::string& what) {
@@ -153,7 +155,7 @@ double check_even_steps(const Eigen::VectorXd& x, const std::vector<int>& line_o
 }
 
 Recording read_time_text(const std::string& path, double sample_rate_hz) {
-  const Rows rows = read_rows(path);
+  const Rows rows = parse_rows(internal::read_file_bytes(path), path);
   const TextTable t = to_table(rows, path, sample_rate_hz <= 0);
   const double fs = sample_rate_hz > 0 ? sample_rate_hz : 1.0 / check_even_steps(t.x, rows.line_of, path);
   return recording_of(t, fs);
@@ -218,8 +220,9 @@ FrfData read_frf_text_set(const std::vector<std::string>& paths, const std::vect
   return h;
 }
 
-LvmFile read_lvm(const std::string& path) {
-  const std::string bytes = internal::read_file_bytes(path);
+LvmFile read_lvm(const std::string& path) { return parse_lvm(internal::read_file_bytes(path), path); }
+
+LvmFile parse_lvm(const std::string& bytes, const std::string& path) {
   internal::LineReader in(bytes);
   std::string_view l;
   if (!in.next(&l) || trim(l).substr(0, 19) != "LabVIEW Measurement")

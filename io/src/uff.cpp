@@ -141,8 +141,7 @@ void parse58_record7(const Ctx& c, std::string_view l, int ln, Uff58* d, long lo
   if (!record_numbers(l, {10, 10, 10, 13, 13, 13}, &v) || v.size() < 3)
     c.fail(record_name(7), ln, "expected ordinate data type, number of points, abscissa spacing, minimum, increment, "
                                "z value (3I10,3E13.5), found '" + std::string(rtrim(l)) + "'");
-  const int type = static_cast<int>(v[0]);
-  if (v[0] != type || (type != 2 && type != 4 && type != 5 && type != 6))
+  if (v[0] != 2 && v[0] != 4 && v[0] != 5 && v[0] != 6)  // compared as doubles: no out-of-range cast
     c.fail(record_name(7), ln, "ordinate data type must be 2 (real single), 4 (real double), 5 (complex single) or "
                                "6 (complex double), found " + std::to_string(v[0]));
   if (!(v[1] >= 1 && v[1] <= static_cast<double>(kMaxPoints)) || v[1] != std::floor(v[1]))
@@ -150,7 +149,7 @@ void parse58_record7(const Ctx& c, std::string_view l, int ln, Uff58* d, long lo
                                    std::to_string(v[1]));
   if (v[2] != 0 && v[2] != 1)
     c.fail(record_name(7), ln, "abscissa spacing must be 0 (uneven) or 1 (even), found " + std::to_string(v[2]));
-  d->ordinate_type = type;
+  d->ordinate_type = static_cast<int>(v[0]);
   *num_points = static_cast<long long>(v[1]);
   d->even = v[2] == 1;
   if (d->even && v.size() < 5)

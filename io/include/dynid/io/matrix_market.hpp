@@ -15,5 +15,7 @@ void write_matrix_market(const std::string& path, const SparseMatrix& A, bool sy
 /// Reads a Matrix Market "coordinate real|integer general|symmetric" file into full (both-triangle) storage.
 /// Duplicate entries are summed. Errors name the file and line.
 SparseMatrix read_matrix_market(const std::string& path);
+/// The same, from a file's content held in memory; `name` names it in messages.
+SparseMatrix parse_matrix_market(const std::string& text, const std::string& name);
 
 }  // namespace dynid

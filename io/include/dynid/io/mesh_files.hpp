@@ -68,6 +68,11 @@ struct MeshData {
 MeshData read_gmsh(const std::string& path);
 /// Reads an Abaqus .inp file (the subset above). Throws InputError.
 MeshData read_abaqus(const std::string& path);
+/// Parses a Gmsh .msh file held in memory: `bytes` is its content, `name` names it in messages.
+MeshData parse_gmsh(const std::string& bytes, const std::string& name);
+/// Parses an Abaqus .inp file held in memory. *INCLUDE files are read from `include_dir`; with include_dir ""
+/// (the default) an *INCLUDE is an InputError, so that the result depends on `bytes` alone.
+MeshData parse_abaqus(const std::string& bytes, const std::string& name, const std::string& include_dir = "");
 /// Reads a mesh file by its extension: .msh (Gmsh) or .inp (Abaqus).
 MeshData read_mesh_file(const std::string& path);
 

@@ -39,6 +39,8 @@ struct TextTable {
 /// Reads a text table whose first column is the abscissa (`x_column`), or, without one, just columns.
 /// Errors name the file, the line and the column (non-numeric cell, wrong number of fields).
 TextTable read_text_table(const std::string& path, bool x_column = true);
+/// The same from a file's content held in memory; `name` names it in messages.
+TextTable parse_text_table(const std::string& text, const std::string& name, bool x_column = true);
 
 /// Checks that x is evenly spaced: each step within 2 % of the first, which must be > 0 (text files round their
 /// abscissa). `line_of[k]` is the file line of sample k. Throws InputError naming the line where the step
@@ -65,6 +67,8 @@ struct LvmFile {
   double header_delta_x = 0;  ///< Delta_X of the header, for comparison with table.dx
 };
 LvmFile read_lvm(const std::string& path);
+/// The same from a file's content held in memory; `name` names it in messages.
+LvmFile parse_lvm(const std::string& bytes, const std::string& name);
 
 /// What a test-data file holds, chosen by extension (.uff/.unv, .lvm, .txt/.csv/.dat/.tsv) or, failing that,
 /// by content.

@@ -1,0 +1,104 @@
+// Hostile files (docs/reliability.md): inputs that once made a reader hang or allocate what a file declared, and
+// the fuzzers' findings (tests/data/hostile/). Each must give an InputError that says what is wrong.
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "dynid/io/case_file.hpp"
+#include "dynid/io/matrix_market.hpp"
+#include "dynid/io/mesh_files.hpp"
+#include "dynid/io/modal_data_io.hpp"
+#include "dynid/io/uff.hpp"
+#include "test_util.hpp"
+
+namespace dynid {
+namespace {
+
+using test::ErrorOf;
+
+#define EXPECT_HAS(text, part) EXPECT_NE((text).find(part), std::string::npos) << (text)
+
+std::string Hostile(const std::string& name) {
+  const std::string path = test::CasesDir() + "/../tests/data/hostile/" + name;
+  std::ifstream in(path, std::ios::binary);
+  EXPECT_TRUE(in) << path;
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// The error for a Matrix Market file "m.mtx" of `text` after "%%MatrixMarket matrix coordinate real ".
+std::string MatrixMarketError(const std::string& text) {
+  return ErrorOf([&] { parse_matrix_market("%%MatrixMarket matrix coordinate real " + text, "m.mtx"); });
+}
+
+TEST(HostileInputs, MatrixMarketDeclaredSizes) {
+  // The declared entry count does not size the allocation; the file ends first.
+  EXPECT_HAS(MatrixMarketError("general\n1000 1000 1000000\n1 1 1\n"), "m.mtx:3: file ends after 1 of 1000000 entries");
+  // fuzz_matrix_market: a declared 2^31 - 1 columns made the sparse matrix allocate 8 GB (a timeout).
+  EXPECT_HAS(MatrixMarketError("general\n2147483647 2147483647 1\n1 1 1\n"),
+             "m.mtx:2: invalid sizes 2147483647 x 2147483647, 1 entries (at most 100000000 rows and columns)");
+  // fuzz_matrix_market: the mirrored entry (1, 3) of a symmetric 4 x 2 file fell outside the matrix (an Eigen
+  // assertion; out-of-bounds writes without assertions).
+  EXPECT_HAS(MatrixMarketError("symmetric\n4 2 1\n3 1 1\n"), "m.mtx:2: a symmetric matrix must be square, not 4 x 2");
+}
+
+TEST(HostileInputs, GmshNodeCountLargerThanTheFile) {
+  const std::string e = ErrorOf([] {
+    parse_gmsh("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n1000000000000\n1 0 0 0\n$EndNodes\n", "big.msh");
+  });
+  EXPECT_HAS(e, "big.msh:5: $Nodes: number of nodes is 1000000000000, but only");
+}
+
+TEST(HostileInputs, AbaqusIncludeOfADeviceIsRefused) {
+  // *INCLUDE of /dev/zero used to read forever; from memory, *INCLUDE is refused outright.
+  const std::string text = "*NODE\n1, 0, 0\n*INCLUDE, INPUT=/dev/zero\n";
+  EXPECT_HAS(ErrorOf([&] { parse_abaqus(text, "dev.inp", "."); }), "/dev/zero: not a regular file");
+  EXPECT_HAS(ErrorOf([&] { parse_abaqus(text, "dev.inp"); }),
+             "dev.inp:3: *INCLUDE: *INCLUDE is not available when the file is read from memory");
+}
+
+TEST(HostileInputs, AbaqusGenerateRange) {
+  // fuzz_abaqus: a GENERATE line from -7144287 to 1 made a set of 7 x 10^6 ids (a timeout); ids are >= 1.
+  EXPECT_HAS(ErrorOf([] { parse_abaqus("*NODE\n1, 0, 0\n*ELSET, ELSET=B, GENERATE\n-7144287, 1\n", "g.inp"); }),
+             "g.inp:4: *ELSET, GENERATE: needs 1 <= first <= last and increment >= 1");
+  EXPECT_HAS(ErrorOf([] { parse_abaqus("*NSET, NSET=A, GENERATE\n1, 2000000000, 1\n", "g.inp"); }),
+             "g.inp:2: *NSET, GENERATE: more than 10^7 ids");
+}
+
+TEST(HostileInputs, CaseFileModelOfADeviceIsRefused) {
+  const std::string e = ErrorOf([] { load_case("/dev/null"); });
+  EXPECT_HAS(e, "/dev/null: not a regular file");
+}
+
+TEST(HostileInputs, GeneratorSizeIsCheckedBeforeBuilding) {
+  const std::string e = ErrorOf([] { parse_case(Hostile("generate-huge.yaml"), "generate-huge.yaml"); });
+  EXPECT_HAS(e, "generate-huge.yaml:5:");
+  EXPECT_HAS(e, "generate.frame3d: 6.38e+37 elements; at most 1e+07 can be generated");
+}
+
+TEST(HostileInputs, ModalDataNumberTooLargeForADouble) {
+  // fuzz_modal_data: nlohmann's out_of_range escaped as a non-InputError exception.
+  const std::string e = ErrorOf([] { parse_modal_data_json(Hostile("big-numbers.json"), "big-numbers.json"); });
+  EXPECT_HAS(e, "big-numbers.json: not valid JSON: ");
+  EXPECT_HAS(e, "number overflow parsing '1e400'");
+}
+
+TEST(HostileInputs, GeneratorOfEveryKindParses) {
+  // fuzz_case under ASan: the generator's spec was a reference into a destroyed temporary (YAML iterator pair).
+  const std::string head = "model:\n  materials: {steel: {E: 2.1e11, rho: 7850, nu: 0.3}}\n"
+                           "  sections: {s: {A: 1e-2, Iy: 1e-4, Iz: 1e-4, J: 1e-6}, b: {A: 1e-2, I: 1e-4}}\n  generate:\n";
+  EXPECT_EQ(parse_case(head + "    beam: {elements: 4, material: steel, section: b}\n", "b.yaml").model.elements().size(), 4u);
+  EXPECT_EQ(parse_case(head + "    frame3d: {material: steel, column: s, beam: s}\n", "f.yaml").model.elements().size(), 8u);
+}
+
+TEST(HostileInputs, UffOrdinateTypeOutOfIntRange) {
+  // fuzz_uff under UBSan: record 7's data type 4.2e10 was cast to int before it was checked.
+  const std::string e =
+      ErrorOf([] { parse_uff(Hostile("uff58b-type-out-of-range.uff"), "uff58b-type-out-of-range.uff"); });
+  EXPECT_HAS(e, "uff58b-type-out-of-range.uff");
+  EXPECT_HAS(e, "ordinate data type must be 2 (real single), 4 (real double), 5 (complex single) or 6 (complex double)");
+}
+
+}  // namespace
+}  // namespace dynid
