@@ -1,5 +1,6 @@
 #include "dynid/engine/correlation.hpp"
 
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 
@@ -20,6 +21,59 @@ Eigen::MatrixXd mac_matrix(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
       mac(i, j) = d > 0 ? AB(i, j) * AB(i, j) / d : 0.0;
     }
   return mac;
+}
+
+std::vector<std::vector<int>> repeated_groups(const Eigen::VectorXd& fb, double rel_tol) {
+  std::vector<std::vector<int>> groups;
+  for (Eigen::Index j = 0; j < fb.size(); ++j) {
+    const bool same = j > 0 && std::abs(fb[j] - fb[j - 1]) <= rel_tol * std::max(std::abs(fb[j]), std::abs(fb[j - 1]));
+    if (same)
+      groups.back().push_back(static_cast<int>(j));
+    else
+      groups.push_back({static_cast<int>(j)});
+  }
+  return groups;
+}
+
+namespace {
+Eigen::MatrixXd group_columns(const Eigen::MatrixXd& B, const std::vector<int>& group) {
+  Eigen::MatrixXd Bg(B.rows(), static_cast<Eigen::Index>(group.size()));
+  for (std::size_t k = 0; k < group.size(); ++k) {
+    if (group[k] < 0 || group[k] >= B.cols()) throw InputError("repeated-mode group names column " + std::to_string(group[k]) + " of " + std::to_string(B.cols()));
+    Bg.col(static_cast<Eigen::Index>(k)) = B.col(group[k]);
+  }
+  return Bg;
+}
+}  // namespace
+
+Eigen::MatrixXd subspace_mac_matrix(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B,
+                                    const std::vector<std::vector<int>>& groups) {
+  Eigen::MatrixXd mac = mac_matrix(A, B);
+  for (const std::vector<int>& g : groups) {
+    if (g.size() < 2) continue;
+    // Orthonormal basis of the group's columns (at the rows of A); rank-revealing, so dependent shapes at few
+    // sensors do not blow up the projector.
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(group_columns(B, g));
+    const Eigen::MatrixXd Q = qr.householderQ() * Eigen::MatrixXd::Identity(B.rows(), qr.rank());
+    for (Eigen::Index i = 0; i < A.cols(); ++i) {
+      const double aa = A.col(i).squaredNorm();
+      const double m = aa > 0 ? (Q.transpose() * A.col(i)).squaredNorm() / aa : 0.0;
+      for (int j : g) mac(i, j) = m;
+    }
+  }
+  return mac;
+}
+
+Eigen::VectorXd subspace_coefficients(const Eigen::VectorXd& a, const Eigen::MatrixXd& B, const std::vector<int>& group) {
+  const Eigen::MatrixXd Bg = group_columns(B, group);
+  if (a.size() != Bg.rows())
+    throw InputError("subspace fit: shape has " + std::to_string(a.size()) + " rows, modes " + std::to_string(Bg.rows()));
+  Eigen::VectorXd c = Bg.completeOrthogonalDecomposition().solve(a);
+  const double n = c.norm();
+  if (n > 0) return c / n;
+  c.setZero();
+  c[0] = 1;  // a orthogonal to the subspace: any member is as good
+  return c;
 }
 
 const ModePair* Pairing::of_a(int a) const {

@@ -22,6 +22,9 @@ namespace dynid {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// Model frequencies this close (relative) are one repeated eigenvalue (symmetric structures; the solver's
+// rounding separates them by about 1e-12).
+constexpr double kRepeatedTolerance = 1e-6;
 
 // Chi-square quantile with 2 degrees of freedom: P(X > q) = alpha  <=>  q = -2 ln(alpha).
 double chi2_2dof(double alpha) { return -2.0 * std::log(alpha); }
@@ -47,6 +50,8 @@ Eigen::VectorXd pseudo_residual(const Eigen::MatrixXd& R) {
 struct Paired {
   std::vector<int> used;        // changed-state modes used (0-based)
   std::vector<int> model_mode;  // their partners (indices into the modal result, rigid modes included)
+  Eigen::MatrixXd partner;      // the partners' shapes at the measured rows; for a repeated eigenvalue, the
+                                // member of its subspace the measured shape shows (subspace_coefficients)
   Eigen::VectorXd mac;
   std::vector<std::string> warnings;
 };
@@ -63,7 +68,12 @@ Paired pair_with_model(const ModalData& data, const std::vector<int>& rows, cons
     for (std::size_t r = 0; r < rows.size(); ++r) Pa(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(j)) = ref.modes(rows[r], elastic[j]);
     fe[static_cast<Eigen::Index>(j)] = ref.frequencies_hz[elastic[j]];
   }
-  const Eigen::MatrixXd mac = mac_matrix(data.shapes, Pa);
+  // Repeated eigenvalues (symmetric structures) are compared as subspaces: the solver's basis is arbitrary.
+  const std::vector<std::vector<int>> groups = repeated_groups(fe, kRepeatedTolerance);
+  std::vector<int> group_of(elastic.size(), -1);
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (int j : groups[g]) group_of[static_cast<std::size_t>(j)] = static_cast<int>(g);
+  const Eigen::MatrixXd mac = subspace_mac_matrix(data.shapes, Pa, groups);
   const Pairing pr = pair_modes(mac, data.frequencies_hz, fe, min_mac);
   Paired out;
   for (int k : pr.unpaired_a) {
@@ -79,19 +89,27 @@ Paired pair_with_model(const ModalData& data, const std::vector<int>& rows, cons
     out.model_mode.push_back(elastic[q.b]);
   }
   out.mac.resize(static_cast<Eigen::Index>(out.used.size()));
+  out.partner.resize(Pa.rows(), static_cast<Eigen::Index>(out.used.size()));
   for (std::size_t k = 0; k < out.used.size(); ++k) {
     const auto* q = pr.of_a(out.used[k]);
     out.mac[static_cast<Eigen::Index>(k)] = q->mac;
+    const std::vector<int>& g = groups[static_cast<std::size_t>(group_of[static_cast<std::size_t>(q->b)])];
+    Eigen::VectorXd v = Pa.col(q->b);
+    if (g.size() > 1) {
+      const Eigen::VectorXd c = subspace_coefficients(data.shapes.col(q->a), Pa, g);
+      v.setZero();
+      for (std::size_t i = 0; i < g.size(); ++i) v += c[static_cast<Eigen::Index>(i)] * Pa.col(g[i]);
+    }
+    out.partner.col(static_cast<Eigen::Index>(k)) = v;
   }
   return out;
 }
 
 // Shapes of the used modes scaled to best match their model partners (sign and size of mass-normalised modes).
-Eigen::MatrixXd scaled_shapes(const ModalData& d, const Paired& p, const std::vector<int>& rows, const ModalResult& ref) {
-  Eigen::MatrixXd U(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(p.used.size()));
+Eigen::MatrixXd scaled_shapes(const ModalData& d, const Paired& p) {
+  Eigen::MatrixXd U(p.partner.rows(), static_cast<Eigen::Index>(p.used.size()));
   for (std::size_t k = 0; k < p.used.size(); ++k) {
-    Eigen::VectorXd v(static_cast<Eigen::Index>(rows.size()));
-    for (std::size_t r = 0; r < rows.size(); ++r) v[static_cast<Eigen::Index>(r)] = ref.modes(rows[r], p.model_mode[k]);
+    const Eigen::VectorXd v = p.partner.col(static_cast<Eigen::Index>(k));
     const Eigen::VectorXd u = d.shapes.col(p.used[k]);
     U.col(static_cast<Eigen::Index>(k)) = u * (u.dot(v) / u.squaredNorm());
   }
@@ -275,7 +293,7 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
     else R = -red.K * U + red.M * U * lam.asDiagonal();
     return R;
   };
-  const Eigen::MatrixXd Uc = scaled_shapes(changed, pc, rows, ref);
+  const Eigen::MatrixXd Uc = scaled_shapes(changed, pc);
   if (S.full_dofs && o.simulated_changed && n <= 3000) {
     const AssembledSystem chs = assemble_system(*o.simulated_changed);
     S.residuals = extended_residuals(chs.K, chs.M, sys.K, sys.M, lam_c, Uc);
@@ -288,7 +306,7 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
     const Paired pr = pair_with_model(refmeas, rows, ref, o.modes, o.min_mac, "reference-state");
     S.warnings.insert(S.warnings.end(), pr.warnings.begin(), pr.warnings.end());
     if (!pr.used.empty())
-      S.pseudo_reference = pseudo_residual(residuals_of(scaled_shapes(refmeas, pr, rows, ref), lambdas(refmeas, pr.used)));
+      S.pseudo_reference = pseudo_residual(residuals_of(scaled_shapes(refmeas, pr), lambdas(refmeas, pr.used)));
   }
   S.delta_pseudo = S.pseudo - S.pseudo_reference;
 

@@ -32,6 +32,23 @@ struct Pairing {
 Pairing pair_modes(const Eigen::MatrixXd& mac, const Eigen::VectorXd& fa, const Eigen::VectorXd& fb,
                    double min_mac = 0.5);
 
+/// Repeated eigenvalues (symmetric structures: the two bending modes of a square tower): groups of the columns
+/// of B whose frequencies fb lie within rel_tol (relative) of their neighbour's, in order; a single mode is a
+/// group of one. Within a group of two or more, any basis of the subspace is an equally valid set of modes, so
+/// the solver's choice is arbitrary and only the subspace can be compared with a measurement.
+std::vector<std::vector<int>> repeated_groups(const Eigen::VectorXd& fb, double rel_tol);
+
+/// mac_matrix(A, B) with, for each column of B in a group of repeated modes, the MAC of a's column with the
+/// group's subspace instead: ||P a||^2 / ||a||^2, P the orthogonal projector onto the group's columns of B. It is
+/// the best MAC any mode of the repeated eigenvalue reaches, the same for every basis of the subspace.
+Eigen::MatrixXd subspace_mac_matrix(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B,
+                                    const std::vector<std::vector<int>>& groups);
+
+/// The unit coefficients c (|c| = 1) of a group of B's columns whose combination sum_k c_k B.col(group[k]) best
+/// matches a (the normalised least-squares fit). With mass-normalised modes of a repeated eigenvalue the
+/// combination is again a mass-normalised mode: the member of the subspace the measurement a shows.
+Eigen::VectorXd subspace_coefficients(const Eigen::VectorXd& a, const Eigen::MatrixXd& B, const std::vector<int>& group);
+
 /// COMAC per DOF over the paired modes: (sum_k |a_ik b_ik|)^2 / (sum_k a_ik^2 sum_k b_ik^2), shapes scaled to
 /// their MAC-consistent sign. 1 = the DOF agrees in every pair.
 Eigen::VectorXd comac(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Pairing& p);
