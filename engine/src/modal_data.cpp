@@ -29,8 +29,10 @@ void ModalData::validate(const std::string& what) const {
     if (!std::isfinite(frequencies_hz[k]) || frequencies_hz[k] <= 0)
       throw InputError(what + ": mode " + std::to_string(k + 1) + " has frequency " + std::to_string(frequencies_hz[k]) +
                        " Hz; frequencies must be finite and > 0 (leave rigid-body modes out)");
-    if (!shapes.col(k).allFinite())
-      throw InputError(what + ": mode " + std::to_string(k + 1) + " has a NaN or Inf shape entry");
+    for (Eigen::Index i = 0; i < shapes.rows(); ++i)
+      if (!std::isfinite(shapes(i, k)))
+        throw InputError(what + ": mode " + std::to_string(k + 1) + " has a NaN or Inf shape entry at DOF " +
+                         to_string(dofs[static_cast<std::size_t>(i)]));
     if (shapes.col(k).squaredNorm() == 0) throw InputError(what + ": mode " + std::to_string(k + 1) + " has an all-zero shape");
   }
   for (std::size_t i = 0; i < dofs.size(); ++i)

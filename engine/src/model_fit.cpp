@@ -537,6 +537,12 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
   if (!ef.ok) throw NumericalError("fit: the model cannot be evaluated at the solution: " + ef.error);
   out.final_hz = paired_hz(ef);
   out.final_mac = ef.mac;
+  if (!out.converged)
+    out.warnings.push_back("the fit stopped without converging (Ceres " + out.termination + " after " +
+                           std::to_string(out.iterations) + " iterations, cost " + std::to_string(out.initial_cost) +
+                           " -> " + std::to_string(out.final_cost) +
+                           "): the parameters are the last iterate, not a minimum; raise max_iterations, or fix or "
+                           "tie the parameters the data cannot determine");
   for (int k = 0; k < measured.num_modes(); ++k)
     if (ef.forced[k])
       out.warnings.push_back("measured mode " + std::to_string(k + 1) + " (" + std::to_string(measured.frequencies_hz[k]) +

@@ -283,8 +283,10 @@ ModalData detect_changed_data(const Case& c, Model* changed) {
   require_section(c, c.detect.has_value(), "detect");
   const DetectSpec& d = *c.detect;
   if (!d.measured_file.empty()) return read_modal_data(d.measured_file);
-  *changed = changed_model(c.model, d.changes);
-  return simulate(*changed, d.measured_dofs, d.options.modes > 0 ? d.options.modes : 6, "simulation of " + c.name);
+  Model local;
+  Model& m = changed ? *changed : local;  // the caller may not want the changed model
+  m = changed_model(c.model, d.changes);
+  return simulate(m, d.measured_dofs, d.options.modes > 0 ? d.options.modes : 6, "simulation of " + c.name);
 }
 
 ModalData update_measured_data(const Case& c) {

@@ -35,6 +35,16 @@ struct Rows {
   std::vector<int> line_of;
 };
 
+// NaN and Inf parse as numbers (from_chars reads "nan", "inf"), but no measurement holds them: an error naming
+// the line and column.
+template <class Fields>
+void require_finite(const std::vector<double>& v, const Fields& f, const std::string& at) {
+  for (std::size_t k = 0; k < v.size(); ++k)
+    if (!std::isfinite(v[k]))
+      throw InputError(at + ": column " + std::to_string(k + 1) + ": '" + std::string(f[k]) +
+                       "' is not a finite number (mark a missing sample by leaving the row out)");
+}
+
 Rows parse_rows(const std::string& bytes, const std::string& path) {
   internal::LineReader in(bytes);
   Rows r;
@@ -56,6 +66,7 @@ Rows parse_rows(const std::string& bytes, const std::string& path) {
       throw InputError(where(path, in.line()) + ": column " + std::to_string(bad + 1) + ": '" + std::string(f[bad]) +
                        "' is not a number");
     }
+    require_finite(v, f, where(path, in.line()));
     if (r.rows.empty()) width = v.size();
     if (v.size() != width)
       throw InputError(where(path, in.line()) + ": " + std::to_string(v.size()) + " fields, the first data row (line " +
@@ -278,6 +289,7 @@ LvmFile parse_lvm(const std::string& bytes, const std::string& path) {
         throw InputError(where(path, in.line()) + ": a second segment; dynid reads single-segment LVM files");
       throw InputError(where(path, in.line()) + ": '" + f[0] + "...' is not a row of numbers");
     }
+    require_finite(v, f, where(path, in.line()));
     if (!rows.empty() && v.size() != rows[0].size())
       throw InputError(where(path, in.line()) + ": " + std::to_string(v.size()) + " fields, the first row has " +
                        std::to_string(rows[0].size()));

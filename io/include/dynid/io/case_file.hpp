@@ -115,7 +115,7 @@ Case load_case(const std::string& path);
 Case parse_case(const std::string& text, const std::string& name, const std::string& dir = ".");
 
 /// The changed state of a detect: case: measured data from its file, or the exact modes of the changed model at
-/// the measured DOFs (then *changed receives that model, for DetectOptions::simulated_changed).
+/// the measured DOFs (then *changed, unless null, receives that model, for DetectOptions::simulated_changed).
 ModalData detect_changed_data(const Case& c, Model* changed);
 /// The measured data of an update: case: from its file, or the simulated target; the first `modes` modes.
 ModalData update_measured_data(const Case& c);
