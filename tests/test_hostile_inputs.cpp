@@ -1,13 +1,20 @@
 // Hostile files (docs/reliability.md): inputs that once made a reader hang or allocate what a file declared, and
 // the fuzzers' findings (tests/data/hostile/). Each must give an InputError that says what is wrong.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "dynid/io/case_file.hpp"
 #include "dynid/io/matrix_market.hpp"
 #include "dynid/io/mesh_files.hpp"
 #include "dynid/io/modal_data_io.hpp"
+#include "dynid/io/output.hpp"
 #include "dynid/io/uff.hpp"
 #include "test_util.hpp"
 
@@ -98,6 +105,60 @@ TEST(HostileInputs, UffOrdinateTypeOutOfIntRange) {
       ErrorOf([] { parse_uff(Hostile("uff58b-type-out-of-range.uff"), "uff58b-type-out-of-range.uff"); });
   EXPECT_HAS(e, "uff58b-type-out-of-range.uff");
   EXPECT_HAS(e, "ordinate data type must be 2 (real single), 4 (real double), 5 (complex single) or 6 (complex double)");
+}
+
+std::string Slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST(NoDataLost, ExistingResultsAreNotOverwrittenWithoutForce) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("dynid-atomic-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string file = (dir / "result.json").string();
+  write_file_atomic(file, "earlier result\n", false);
+  EXPECT_HAS(ErrorOf([&] { write_file_atomic(file, "new", false); }), "result.json: file exists; pass --force");
+  EXPECT_EQ(Slurp(file), "earlier result\n");
+  EXPECT_HAS(ErrorOf([&] { refuse_existing({(dir / "other.png").string(), file}, false); }), "result.json: file exists");
+  write_file_atomic(file, "replaced\n", true);
+  EXPECT_EQ(Slurp(file), "replaced\n");
+  EXPECT_HAS(ErrorOf([&] { write_file_atomic((dir / "no-such-folder" / "r.json").string(), "x", true); }),
+             "does not exist");
+  // No temporary file is left behind by a finished write.
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(dir)) entries += e.is_regular_file();
+  EXPECT_EQ(entries, 1);
+  fs::remove_all(dir);
+}
+
+TEST(NoDataLost, AKilledWriteLeavesTheEarlierFileWhole) {
+  // A child process replaces a file with 400 MB and is killed (SIGKILL: no clean-up runs) while it writes. The
+  // file then holds either the earlier content or the whole new one, never a part (temp file + rename).
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("dynid-kill-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string file = (dir / "result.json").string();
+  write_file_atomic(file, "earlier result\n", false);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    try {
+      write_file_atomic(file, std::string(400u << 20, 'x'), true);
+    } catch (...) {
+    }
+    ::_exit(0);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  ::kill(child, SIGKILL);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  const auto size = fs::file_size(file);
+  EXPECT_TRUE(size == 15 || size == (400u << 20)) << size << " bytes";
+  if (size == 15) EXPECT_EQ(Slurp(file), "earlier result\n");
+  fs::remove_all(dir);
 }
 
 }  // namespace
