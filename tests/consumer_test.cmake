@@ -1,0 +1,28 @@
+# ctest install.consumer: installs dynid from the build tree BUILD into WORK/stage, moves the installed tree to
+# WORK/moved (the package must be relocatable), then configures, builds and runs tests/consumer against it.
+#   cmake -DBUILD=... -DSOURCE=... -DWORK=... -P consumer_test.cmake
+file(REMOVE_RECURSE ${WORK})
+function(run)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "failed (${rc}): ${ARGN}\n${out}\n${err}")
+  endif()
+  set(last_output "${out}" PARENT_SCOPE)
+endfunction()
+run(${CMAKE_COMMAND} --install ${BUILD} --prefix ${WORK}/stage)
+file(RENAME ${WORK}/stage ${WORK}/moved)
+foreach(f bin/dynid include/dynid/engine/detect.hpp lib/cmake/dynid/dynidConfig.cmake lib/libdynid_io.a)
+  if(NOT EXISTS ${WORK}/moved/${f})
+    message(FATAL_ERROR "the installed package lacks ${f}")
+  endif()
+endforeach()
+run(${CMAKE_COMMAND} -S ${SOURCE}/tests/consumer -B ${WORK}/consumer -DCMAKE_BUILD_TYPE=Release
+    -DCMAKE_PREFIX_PATH=${WORK}/moved)
+run(${CMAKE_COMMAND} --build ${WORK}/consumer -j 2)
+run(${WORK}/consumer/consumer)
+message("${last_output}")
+if(NOT last_output MATCHES "dynid consumer: ok")
+  message(FATAL_ERROR "the consumer did not say ok")
+endif()
+run(${WORK}/moved/bin/dynid --version)
+message("installed dynid: ${last_output}")
