@@ -25,14 +25,15 @@ using test::ErrorOf;
 
 #define EXPECT_HAS(text, part) EXPECT_NE((text).find(part), std::string::npos) << (text)
 
-std::string Hostile(const std::string& name) {
-  const std::string path = test::CasesDir() + "/../tests/data/hostile/" + name;
+std::string Slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   EXPECT_TRUE(in) << path;
   std::ostringstream ss;
   ss << in.rdbuf();
   return ss.str();
 }
+
+std::string Hostile(const std::string& name) { return Slurp(test::CasesDir() + "/../tests/data/hostile/" + name); }
 
 /// The error for a Matrix Market file "m.mtx" of `text` after "%%MatrixMarket matrix coordinate real ".
 std::string MatrixMarketError(const std::string& text) {
@@ -107,19 +108,26 @@ TEST(HostileInputs, UffOrdinateTypeOutOfIntRange) {
   EXPECT_HAS(e, "ordinate data type must be 2 (real single), 4 (real double), 5 (complex single) or 6 (complex double)");
 }
 
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+namespace fs = std::filesystem;
+
+// A fresh folder holding one earlier result, result.json ("earlier result\n"); removed afterwards.
+struct ResultFolder {
+  explicit ResultFolder(const std::string& tag)
+      : dir(fs::temp_directory_path() / ("dynid-" + tag + "-" + std::to_string(::getpid()))),
+        file((dir / "result.json").string()) {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    write_file_atomic(file, "earlier result\n", false);
+  }
+  ~ResultFolder() { fs::remove_all(dir); }
+  const fs::path dir;
+  const std::string file;
+};
 
 TEST(NoDataLost, ExistingResultsAreNotOverwrittenWithoutForce) {
-  namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / ("dynid-atomic-" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  const std::string file = (dir / "result.json").string();
-  write_file_atomic(file, "earlier result\n", false);
+  const ResultFolder f("atomic");
+  const fs::path& dir = f.dir;
+  const std::string& file = f.file;
   EXPECT_HAS(ErrorOf([&] { write_file_atomic(file, "new", false); }), "result.json: file exists; pass --force");
   EXPECT_EQ(Slurp(file), "earlier result\n");
   EXPECT_HAS(ErrorOf([&] { refuse_existing({(dir / "other.png").string(), file}, false); }), "result.json: file exists");
@@ -131,17 +139,13 @@ TEST(NoDataLost, ExistingResultsAreNotOverwrittenWithoutForce) {
   int entries = 0;
   for (const auto& e : fs::directory_iterator(dir)) entries += e.is_regular_file();
   EXPECT_EQ(entries, 1);
-  fs::remove_all(dir);
 }
 
 TEST(NoDataLost, AKilledWriteLeavesTheEarlierFileWhole) {
   // A child process replaces a file with 400 MB and is killed (SIGKILL: no clean-up runs) while it writes. The
   // file then holds either the earlier content or the whole new one, never a part (temp file + rename).
-  namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / ("dynid-kill-" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  const std::string file = (dir / "result.json").string();
-  write_file_atomic(file, "earlier result\n", false);
+  const ResultFolder f("kill");
+  const std::string& file = f.file;
   const pid_t child = ::fork();
   ASSERT_GE(child, 0);
   if (child == 0) {
@@ -158,7 +162,6 @@ TEST(NoDataLost, AKilledWriteLeavesTheEarlierFileWhole) {
   const auto size = fs::file_size(file);
   EXPECT_TRUE(size == 15 || size == (400u << 20)) << size << " bytes";
   if (size == 15) EXPECT_EQ(Slurp(file), "earlier result\n");
-  fs::remove_all(dir);
 }
 
 }  // namespace
