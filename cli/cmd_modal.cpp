@@ -1,9 +1,11 @@
 // dynid modal CASE [--modes N] [--json FILE]: modal analysis of a case's model.
+// dynid export-matrices CASE DIR: the case's model as matrices (docs/matrix-input.md).
 #include <fmt/core.h>
 
 #include "commands.hpp"
 #include "dynid/engine/modal.hpp"
 #include "dynid/io/case_file.hpp"
+#include "dynid/io/matrix_model.hpp"
 #include "dynid/io/output.hpp"
 #include "progress.hpp"
 
@@ -69,6 +71,30 @@ void register_modal(CLI::App& app, GlobalOptions& g) {
   cmd->add_option("--json", a->json, "Write the results as JSON to FILE");
   cmd->add_flag("--force", a->force, "Overwrite existing output files");
   cmd->callback([a, &g]() { g.exit_code = run_guarded("modal", [&] { return run_modal(*a, g); }); });
+
+  struct ExportArgs {
+    std::string case_path, dir;
+    bool force = false;
+  };
+  auto x = std::make_shared<ExportArgs>();
+  CLI::App* ex = app.add_subcommand(
+      "export-matrices", "Write a case's model as matrices: K.mtx, M.mtx, the DOF and node tables, element matrices "
+                         "and the model section that reads them back (docs/matrix-input.md)");
+  ex->add_option("CASE", x->case_path, "Case file or folder (with case.yaml)")->required();
+  ex->add_option("DIR", x->dir, "Folder to write into (created if missing)")->required();
+  ex->add_flag("--force", x->force, "Overwrite existing files");
+  ex->callback([x, &g]() {
+    g.exit_code = run_guarded("export-matrices", [&] {
+      const Case c = load_case(x->case_path);
+      const auto paths = write_matrix_model(c.model, x->dir, x->force);
+      if (!g.quiet) {
+        fmt::print("dynid export-matrices: {} ({} DOFs, {} elements) -> {}\n", c.name, c.model.num_dofs(),
+                   c.model.num_elements(), x->dir);
+        for (const std::string& p : paths) fmt::print("  {}\n", p);
+      }
+      return 0;
+    });
+  });
 }
 
 }  // namespace dynid::cli

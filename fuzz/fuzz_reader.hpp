@@ -20,6 +20,7 @@ inline void lower_limits() {
   limits.max_generated_elements = 200;
   limits.max_generated_ids = 100000;
   limits.max_matrix_dimension = 100000;
+  limits.max_element_dofs = 200;
 }
 
 template <class Reader>

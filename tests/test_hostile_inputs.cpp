@@ -25,13 +25,7 @@ using test::ErrorOf;
 
 #define EXPECT_HAS(text, part) EXPECT_NE((text).find(part), std::string::npos) << (text)
 
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  EXPECT_TRUE(in) << path;
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::Slurp;
 
 std::string Hostile(const std::string& name) { return Slurp(test::CasesDir() + "/../tests/data/hostile/" + name); }
 
@@ -161,7 +155,9 @@ TEST(NoDataLost, AKilledWriteLeavesTheEarlierFileWhole) {
   ::waitpid(child, &status, 0);
   const auto size = fs::file_size(file);
   EXPECT_TRUE(size == 15 || size == (400u << 20)) << size << " bytes";
-  if (size == 15) EXPECT_EQ(Slurp(file), "earlier result\n");
+  if (size == 15) {
+    EXPECT_EQ(Slurp(file), "earlier result\n");
+  }
 }
 
 }  // namespace

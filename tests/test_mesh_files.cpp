@@ -20,12 +20,7 @@ namespace fs = std::filesystem;
 
 std::string MeshDir() { return test::CasesDir() + "/../tests/data/mesh"; }
 
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::Slurp;
 
 /// Writes `text` to a file in a scratch folder and returns its path.
 std::string Write(const std::string& name, const std::string& text) {

@@ -2,6 +2,8 @@
 
 #include <Eigen/Dense>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 namespace dynid::test {
 
@@ -12,6 +14,14 @@ double SubspaceGap(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
                              Eigen::MatrixXd::Identity(B.rows(), B.cols());
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Qa.transpose() * Qb);
   return 1.0 - svd.singularValues().minCoeff();
+}
+
+std::string Slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  EXPECT_TRUE(in) << path;
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
 }
 
 std::string CasesDir() { return DYNID_CASES_DIR; }

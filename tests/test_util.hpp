@@ -41,6 +41,9 @@ std::string ErrorOf(F&& f) {
   return "(no error)";
 }
 
+/// The whole content of a file (a failed expectation if it cannot be read).
+std::string Slurp(const std::string& path);
+
 /// Folder of the repository's bundled cases and of ../shared (set by CMake).
 std::string CasesDir();
 std::string SharedDir();

@@ -224,7 +224,8 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
   if (o.candidates.empty()) {
     for (int e = 0; e < model.num_elements(); ++e) {
       const ElementType t = model.elements()[e].type;
-      if (t == ElementType::Beam2D || t == ElementType::Frame2D || t == ElementType::Frame3D) cand.push_back(e);
+      if (t == ElementType::Beam2D || t == ElementType::Frame2D || t == ElementType::Frame3D || t == ElementType::Matrix)
+        cand.push_back(e);
     }
   } else {
     for (int id : o.candidates) {
@@ -233,7 +234,7 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
       cand.push_back(e);
     }
   }
-  if (cand.empty()) throw InputError("detect: the model has no beam or frame elements to examine");
+  if (cand.empty()) throw InputError("detect: the model has no beam, frame or matrix elements to examine");
 
   // Reference modal analysis: enough modes to pair and, for reduced data, for SEREP.
   const int a = static_cast<int>(rows.size());

@@ -67,6 +67,8 @@ int ParametricModel::add(const Parameter& p) {
       const std::string eid = "element " + std::to_string(model_.elements()[e].id);
       if (t == ElementType::Spring && p.kind != ParameterKind::kStiffness)
         throw InputError(who + ": " + eid + " is a spring; only a stiffness factor (E) acts on it");
+      if (t == ElementType::Matrix && p.kind != ParameterKind::kStiffness && p.kind != ParameterKind::kMass)
+        throw InputError(who + ": " + eid + " is given by its matrices; only a stiffness (E) or mass (rho) factor acts on it");
       if (t == ElementType::PointMass && p.kind != ParameterKind::kMass)
         throw InputError(who + ": " + eid + " is a point mass; only a mass factor (rho) acts on it");
       const int sec = model_.elements()[e].section;

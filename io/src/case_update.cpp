@@ -188,7 +188,8 @@ UpdateSpec parse_update(const YAML::Node& n, const YamlCtx& ctx, const Model& mo
             const ElementType t = model.elements()[e].type;
             const bool fits = base.kind == ParameterKind::kStiffness ? t != ElementType::PointMass
                               : base.kind == ParameterKind::kMass    ? t != ElementType::Spring
-                                                                     : t != ElementType::PointMass && t != ElementType::Spring;
+                                                                     : t != ElementType::PointMass && t != ElementType::Spring &&
+                                                                           t != ElementType::Matrix;
             if (in && fits) p.elements.push_back(e);
           }
           if (p.elements.empty()) ctx.fail(r, "parameter " + name + ": the region holds no element");

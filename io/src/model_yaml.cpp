@@ -6,6 +6,7 @@
 #include <regex>
 #include <set>
 
+#include "dynid/io/matrix_model.hpp"
 #include "dynid/io/mesh_files.hpp"
 #include "dynid/io/limits.hpp"
 #include "dynid/mesh/generators.hpp"
@@ -98,7 +99,8 @@ struct Parser {
   ElementType member_type(const YAML::Node& n, const std::string& w, const std::string& hint = "") const {
     const std::string t = ctx.string(n, w + " type");
     ElementType type;
-    if (!parse_element_type(t, &type) || type == ElementType::PointMass || type == ElementType::Spring)
+    if (!parse_element_type(t, &type) || type == ElementType::PointMass || type == ElementType::Spring ||
+        type == ElementType::Matrix)
       fail(n, w + ": unknown element type '" + t + "' (known: beam2d, frame2d, frame3d" + hint + ")");
     return type;
   }
@@ -326,6 +328,43 @@ struct Parser {
     return s;
   }
 
+  /// model: {matrices: {dofs, nodes, elements, groups: {name: {K, M}}, K, M}}: a model exported from another FE
+  /// code as matrices (docs/matrix-input.md); its elements are Matrix elements.
+  void read_matrices(const YAML::Node& m) {
+    ctx.require_map(m, "model matrices");
+    ctx.only_keys(m, "model matrices", {"dofs", "nodes", "elements", "groups", "K", "M"});
+    for (const char* k : {"dofs", "nodes"})
+      if (!m[k]) fail(m, std::string("model matrices: '") + k + "' is missing (" +
+                             (k[0] == 'd' ? "the DOF table: one line 'node, dof' per equation" : "the node table: 'id, x, y, z'") + ")");
+    if (!m["elements"] && !m["groups"]) fail(m, "model matrices: give 'elements' (element matrices) or 'groups' (group matrices)");
+    if (!m["K"] != !m["M"]) fail(m, "model matrices: give both K and M (the assembled matrices), or neither");
+    MatrixModelFiles f;
+    auto file = [&](const YAML::Node& n, const std::string& w) {
+      const std::string path = resolve(dir, ctx.string(n, w));
+      std::error_code ec;
+      if (!std::filesystem::is_regular_file(path, ec)) fail(n, w + ": cannot open '" + path + "'");
+      return path;
+    };
+    f.dofs = file(m["dofs"], "matrices dofs");
+    f.nodes = file(m["nodes"], "matrices nodes");
+    if (m["elements"]) f.elements = file(m["elements"], "matrices elements");
+    if (m["K"]) {
+      f.K = file(m["K"], "matrices K");
+      f.M = file(m["M"], "matrices M");
+    }
+    if (m["groups"]) {
+      ctx.require_map(m["groups"], "matrices groups");
+      for (const auto& kv : m["groups"]) {
+        const std::string name = kv.first.Scalar(), w = "matrices group '" + name + "'";
+        ctx.require_map(kv.second, w);
+        ctx.only_keys(kv.second, w, {"K", "M"});
+        if (!kv.second["K"] || !kv.second["M"]) fail(kv.second, w + ": needs K and M (Matrix Market files)");
+        f.groups.push_back({name, file(kv.second["K"], w + " K"), file(kv.second["M"], w + " M")});
+      }
+    }
+    add_matrix_model(f, &model, notes);
+  }
+
   /// model: {file: frame.msh | frame.inp}: reads the mesh file and adds its materials and sections (Abaqus),
   /// except those the case file defines under the same name.
   void read_mesh(const YAML::Node& f) {
@@ -489,7 +528,7 @@ Model parse_model(const YAML::Node& node, const YamlCtx& ctx, const std::string&
   ctx.require_map(node, "model");
   ctx.only_keys(node, "model", {"element", "mass", "rotary_inertia", "materials", "sections", "defaults", "nodes",
                                 "elements", "point_masses", "springs", "supports", "generate", "units", "file",
-                                "groups"});
+                                "groups", "matrices"});
   Parser p{ctx, {}, {}, {}, {}, {}, {}, {}, ElementType::Frame2D, false, dir, notes, {}, {}, {}, {}};
   if (node["element"]) {
     p.default_type = p.member_type(node["element"], "model");
@@ -519,7 +558,11 @@ Model parse_model(const YAML::Node& node, const YamlCtx& ctx, const std::string&
     }
   }
   if (node["groups"] && !node["file"]) ctx.fail(node["groups"], "model: groups: needs file: (a mesh file)");
-  if (node["file"]) {
+  if (node["matrices"]) {
+    for (const char* k : {"nodes", "elements", "generate", "file", "element", "mass", "rotary_inertia", "materials", "sections", "defaults"})
+      if (node[k]) ctx.fail(node[k], std::string("model: '") + k + "' cannot be combined with matrices (the matrices define the model)");
+    p.read_matrices(node["matrices"]);
+  } else if (node["file"]) {
     for (const char* k : {"nodes", "elements", "generate"})
       if (node[k]) ctx.fail(node[k], std::string("model: '") + k + "' cannot be combined with file");
     p.build_mesh_model(node["groups"]);
@@ -539,7 +582,7 @@ Model parse_model(const YAML::Node& node, const YamlCtx& ctx, const std::string&
   if (node["point_masses"]) p.parse_point_masses(node["point_masses"]);
   if (node["springs"]) p.parse_springs(node["springs"]);
   if (node["supports"]) p.parse_supports(node["supports"]);
-  else if (!node["generate"] && !node["file"]) ctx.fail(node, "model: supports are missing (a list of supports, or 'free' for a free-free structure)");
+  else if (!node["generate"] && !node["file"] && !node["matrices"]) ctx.fail(node, "model: supports are missing (a list of supports, or 'free' for a free-free structure)");
   try {
     p.model.finalize();
   } catch (const InputError& e) {

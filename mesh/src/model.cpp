@@ -11,7 +11,7 @@
 namespace dynid {
 
 namespace {
-constexpr std::array<std::string_view, 5> kTypeNames = {"beam2d", "frame2d", "frame3d", "point_mass", "spring"};
+constexpr std::array<std::string_view, 6> kTypeNames = {"beam2d", "frame2d", "frame3d", "point_mass", "spring", "matrix"};
 
 std::string elem_label(const Element& e) {
   return "element " + std::to_string(e.id) + " (" + std::string(element_type_name(e.type)) + ")";
@@ -96,6 +96,23 @@ bool parse_element_type(std::string_view name, ElementType* out) {
   return false;
 }
 
+Element make_matrix_element(int id, MatrixElementData data, std::string group) {
+  Element e;
+  e.id = id;
+  e.type = ElementType::Matrix;
+  e.num_nodes = 0;
+  std::vector<int> nodes = data.nodes;
+  if (nodes.empty())
+    for (const auto& [node, d] : data.dofs) nodes.push_back(node);
+  for (int node : nodes) {
+    if (e.num_nodes == 2 || (e.num_nodes == 1 && e.node_ids[0] == node)) continue;
+    e.node_ids[e.num_nodes++] = node;
+  }
+  e.group = std::move(group);
+  e.matrix = std::make_shared<const MatrixElementData>(std::move(data));
+  return e;
+}
+
 Eigen::MatrixXd ElementParts::K() const { return K_axial + K_bending + K_torsion + K_discrete + K_geometric; }
 Eigen::MatrixXd ElementParts::M() const { return M_translational + M_rotary + M_discrete; }
 
@@ -164,18 +181,66 @@ void Model::require_finalized(const char* what) const {
   if (!finalized_) throw InputError(std::string(what) + ": the model is not finalized (call Model::finalize())");
 }
 
+void Model::finalize_matrix_element(int k, std::vector<DofMask>* active) {
+  const Element& e = elements_[k];
+  const std::string who = elem_label(e);
+  if (!e.matrix) throw InputError(who + ": no matrices given");
+  const MatrixElementData& d = *e.matrix;
+  const Eigen::Index n = static_cast<Eigen::Index>(d.dofs.size());
+  if (n == 0) throw InputError(who + ": has no DOFs");
+  if (d.K.rows() != n || d.K.cols() != n || d.M.rows() != n || d.M.cols() != n)
+    throw InputError(who + ": its stiffness and mass matrices must be " + std::to_string(n) + " x " +
+                     std::to_string(n) + " (one row per DOF), got " + std::to_string(d.K.rows()) + " x " +
+                     std::to_string(d.K.cols()) + " and " + std::to_string(d.M.rows()) + " x " + std::to_string(d.M.cols()));
+  for (double f : {e.factors.E, e.factors.rho})
+    if (!finite_positive(f)) throw InputError(who + ": property factors must be finite and > 0");
+  auto& out = matrix_dofs_[k];
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto& [id, t] = d.dofs[i];
+    const int node = node_index(id);
+    if (node < 0) throw InputError(who + ": node " + std::to_string(id) + " does not exist");
+    for (const auto& [m, u] : out)
+      if (m == node && u == t)
+        throw InputError(who + ": DOF " + std::string(dof_name(t)) + " at node " + std::to_string(id) + " is listed twice");
+    out.emplace_back(node, t);
+    (*active)[node] |= dof_bit(t);
+  }
+  for (const auto* A : {&d.K, &d.M}) {
+    const char* what = A == &d.K ? "stiffness" : "mass";
+    if (!A->allFinite()) throw InputError(who + ": its " + what + " matrix has a NaN or infinite entry");
+    const double scale = A->cwiseAbs().maxCoeff();
+    for (Eigen::Index j = 0; j < n; ++j)
+      for (Eigen::Index i = j + 1; i < n; ++i)
+        if (std::abs((*A)(i, j) - (*A)(j, i)) > 1e-12 * scale)
+          throw InputError(who + ": its " + what + " matrix is not symmetric (entries " + std::to_string(i + 1) + "," +
+                           std::to_string(j + 1) + " and " + std::to_string(j + 1) + "," + std::to_string(i + 1) + " differ)");
+  }
+  for (int id : d.nodes)
+    if (node_index(id) < 0) throw InputError(who + ": node " + std::to_string(id) + " does not exist");
+  for (int a = 0; a < 2; ++a) {
+    element_nodes_[k][a] = a < e.num_nodes ? node_index(e.node_ids[a]) : -1;
+    if (a < e.num_nodes && element_nodes_[k][a] < 0)
+      throw InputError(who + ": node " + std::to_string(e.node_ids[a]) + " does not exist");
+  }
+}
+
 void Model::finalize() {
   warnings_.clear();
   const int nn = static_cast<int>(nodes_.size());
   if (elements_.empty()) throw InputError("the model has no elements");
   element_nodes_.assign(elements_.size(), {{-1, -1}});
   point_mass_dofs_.assign(elements_.size(), 0);
+  matrix_dofs_.assign(elements_.size(), {});
   std::vector<DofMask> active(nn, 0), restrained(nn, 0);
   std::vector<int> pm;  // point masses, resolved after DOF activation
 
   for (std::size_t k = 0; k < elements_.size(); ++k) {
     const Element& e = elements_[k];
     const std::string who = elem_label(e);
+    if (e.type == ElementType::Matrix) {
+      finalize_matrix_element(static_cast<int>(k), &active);
+      continue;
+    }
     if (e.num_nodes < 1 || e.num_nodes > 2) throw InputError(who + ": must have 1 or 2 nodes");
     for (int a = 0; a < e.num_nodes; ++a) {
       const int n = node_index(e.node_ids[a]);
@@ -259,8 +324,12 @@ void Model::finalize() {
     if (n < 0) throw InputError("support at node " + std::to_string(id) + ": node does not exist");
     restrained[n] |= mask;
   }
+  std::vector<char> drawn(nn, 0);  // nodes of matrix elements without DOFs (supported ends) are connected too
+  for (std::size_t k = 0; k < elements_.size(); ++k)
+    if (elements_[k].type == ElementType::Matrix)
+      for (int id : elements_[k].matrix->nodes) drawn[node_index(id)] = 1;
   for (int n = 0; n < nn; ++n)
-    if (active[n] == 0) warnings_.push_back("node " + std::to_string(nodes_[n].id) + " is not connected to any element");
+    if (active[n] == 0 && !drawn[n]) warnings_.push_back("node " + std::to_string(nodes_[n].id) + " is not connected to any element");
   dofs_ = DofMap(active, restrained);
   if (dofs_.num_free() == 0) throw InputError("the model has no free DOFs (every DOF is restrained)");
   finalized_ = true;
@@ -352,6 +421,7 @@ std::vector<std::pair<int, Dof>> Model::element_dof_types(int e) const {
   switch (el.type) {
     case ElementType::PointMass: mask = point_mass_dofs_[e]; break;
     case ElementType::Spring: mask = el.spring_dofs; break;
+    case ElementType::Matrix: return matrix_dofs_[e];
     default: mask = structural_dofs(el.type);
   }
   std::vector<std::pair<int, Dof>> out;
@@ -425,6 +495,14 @@ ElementParts Model::element_parts(int e) const {
   require_finalized("element_parts");
   const Element& el = elements_[e];
   ElementParts p;
+  if (el.type == ElementType::Matrix) {
+    const Eigen::Index n = el.matrix->K.rows();
+    for (Eigen::MatrixXd* m : {&p.K_axial, &p.K_bending, &p.K_torsion, &p.K_geometric, &p.M_translational, &p.M_rotary})
+      m->setZero(n, n);
+    p.K_discrete = el.factors.E * el.matrix->K;
+    p.M_discrete = el.factors.rho * el.matrix->M;
+    return p;
+  }
   if (el.type == ElementType::PointMass || el.type == ElementType::Spring) {
     const int n = static_cast<int>(element_dof_types(e).size());
     for (Eigen::MatrixXd* m : {&p.K_axial, &p.K_bending, &p.K_torsion, &p.K_discrete, &p.K_geometric,
@@ -468,7 +546,7 @@ ElementParts Model::element_parts(int e) const {
 Eigen::MatrixXd Model::unit_geometric_stiffness(int e) const {
   require_finalized("unit_geometric_stiffness");
   const ElementType t = elements_[e].type;
-  if (t == ElementType::PointMass || t == ElementType::Spring)
+  if (t == ElementType::PointMass || t == ElementType::Spring || t == ElementType::Matrix)
     throw InputError("element " + std::to_string(elements_[e].id) + ": only beams and frames have a geometric stiffness");
   internal::MemberLocal loc;
   Eigen::MatrixXd T;

@@ -13,6 +13,7 @@ struct ReaderLimits {
   double max_generated_elements = 1e7;   ///< elements one case-file `generate:` block builds
   long long max_generated_ids = 10000000;  ///< ids one Abaqus *NSET / *ELSET GENERATE line makes
   long long max_matrix_dimension = 100000000;  ///< rows or columns of a Matrix Market matrix
+  int max_element_dofs = 2000;  ///< DOFs of one element, group or remainder of a matrix model (stored dense)
 };
 
 /// The process-wide limits (mutable: a host program or a fuzz target may lower or raise them).

@@ -6,6 +6,8 @@
 //   Frame3D  space frame; DOFs (ux, uy, uz, rx, ry, rz) per node; local axes from an orientation vector.
 //   PointMass  mass m on the node's active translations, rotary inertia (Jx, Jy, Jz) on its active rotations.
 //   Spring   translational or rotational spring on a set of DOF types, grounded (one node) or between two nodes.
+//   Matrix   an element given by its matrices: any list of (node, DOF type) pairs with stiffness and mass
+//            matrices in global coordinates (element or group matrices exported from another FE code).
 // Each element's global DOF map and its stiffness and mass matrices are available per element
 // (element_dofs(), element_matrices(), element_parts()); sensitivities and residual forces use them.
 #pragma once
@@ -13,6 +15,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <map>
+#include <memory>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -26,8 +29,9 @@ namespace internal {
 struct MemberLocal;
 }
 
-enum class ElementType { Beam2D, Frame2D, Frame3D, PointMass, Spring };
-std::string_view element_type_name(ElementType t);  // "beam2d", "frame2d", "frame3d", "point_mass", "spring"
+enum class ElementType { Beam2D, Frame2D, Frame3D, PointMass, Spring, Matrix };
+/// "beam2d", "frame2d", "frame3d", "point_mass", "spring", "matrix"
+std::string_view element_type_name(ElementType t);
 bool parse_element_type(std::string_view name, ElementType* out);
 
 enum class MassType { Consistent, Lumped };
@@ -64,6 +68,17 @@ struct PropertyFactors {
   double E = 1, rho = 1, A = 1, I = 1;
 };
 
+/// The content of a Matrix element: its DOFs as (user node id, DOF type) pairs, in matrix order, and its
+/// stiffness and mass matrices on them (global coordinates, symmetric, full storage). Shared between copies of
+/// a model (it is never changed after construction).
+struct MatrixElementData {
+  std::vector<std::pair<int, Dof>> dofs;
+  /// The nodes the element connects (user ids), for geometry and drawing; may include supported nodes that
+  /// have no DOF in `dofs`. Empty = the nodes of `dofs`.
+  std::vector<int> nodes;
+  Eigen::MatrixXd K, M;
+};
+
 struct Element {
   int id = 0;
   ElementType type = ElementType::Frame2D;
@@ -79,12 +94,18 @@ struct Element {
   double axial_force = 0;  // beams and frames: axial force (tension > 0) -> geometric stiffness (preload)
   PropertyFactors factors;
   std::string group;  // optional group name (updating parameters may act per group)
+  /// Matrix elements: DOFs and matrices; K scales with factors.E, M with factors.rho. node_ids / num_nodes
+  /// hold the element's first two distinct nodes (for drawing); make_matrix_element() fills them.
+  std::shared_ptr<const MatrixElementData> matrix;
 };
 
+/// A Matrix element with user id `id` from its DOFs and matrices (see MatrixElementData).
+Element make_matrix_element(int id, MatrixElementData data, std::string group = "");
+
 /// Element matrices split into parts that are linear in one property each, in global coordinates:
-///   K = K_axial (~ E A) + K_bending (~ E I) + K_torsion (~ G J) + K_discrete (springs)
+///   K = K_axial (~ E A) + K_bending (~ E I) + K_torsion (~ G J) + K_discrete (springs, matrix elements ~ E)
 ///       + K_geometric (~ axial force; independent of the property factors)
-///   M = M_translational (~ rho A) + M_rotary (~ rho I, only with rotary inertia) + M_discrete (point masses)
+///   M = M_translational (~ rho A) + M_rotary (~ rho I, only with rotary inertia) + M_discrete (point masses, matrix elements ~ rho)
 /// Each part already includes the element's current property factors.
 struct ElementParts {
   Eigen::MatrixXd K_axial, K_bending, K_torsion, K_discrete, K_geometric;
@@ -163,6 +184,7 @@ class Model : public ElementSource {
 
  private:
   void require_finalized(const char* what) const;
+  void finalize_matrix_element(int k, std::vector<DofMask>* active);
   void member_local(int e, internal::MemberLocal* loc, Eigen::MatrixXd* T, const double* axial_force = nullptr) const;
   std::vector<Node> nodes_;
   std::vector<Material> materials_;
@@ -172,6 +194,7 @@ class Model : public ElementSource {
   std::vector<std::pair<int, DofMask>> restraints_;  // (node id, dofs)
   std::vector<std::array<int, 2>> element_nodes_;
   std::vector<DofMask> point_mass_dofs_;  // per element: DOFs a point mass acts on (set at finalize)
+  std::vector<std::vector<std::pair<int, Dof>>> matrix_dofs_;  // per Matrix element: (node index, DOF type)
   MassType mass_type_ = MassType::Consistent;
   bool rotary_inertia_ = false;
   bool free_free_ = false;

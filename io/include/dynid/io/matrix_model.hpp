@@ -1,0 +1,64 @@
+// dynid/io/matrix_model.hpp -- models given as matrices exported from another FE code (docs/matrix-input.md):
+// the DOF table, the node table, element matrices (or group matrices) and optionally the assembled K and M as
+// Matrix Market files. The reader turns them into a dynid Model of Matrix elements, so that every engine step
+// (modal, detect, update, discover) runs on them; the writer exports any dynid model in the same format.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "dynid/mesh/model.hpp"
+
+namespace dynid {
+
+/// The files of a matrix model. Paths as given (the case reader resolves them against the case folder).
+struct MatrixModelFiles {
+  std::string dofs;      ///< DOF table: row i = equation i: "node, dof" (dof: ux..rz or 1..6)   (required)
+  std::string nodes;     ///< node table: "id, x, y, z"                                           (required)
+  std::string elements;  ///< element matrices (the "%%dynid element-matrices" format)
+  struct Group {
+    std::string name, K, M;  ///< a group's stiffness and mass matrices on the global equations (Matrix Market)
+  };
+  std::vector<Group> groups;  ///< group matrices, each one Matrix element (in addition to `elements`)
+  std::string K, M;  ///< assembled matrices (Matrix Market), optional: checked against the sum of the elements;
+                     ///< what they hold beyond it becomes a "remainder" element
+};
+
+/// One row of a DOF table: equation i is DOF `dof` of node `node` (user id).
+struct DofRow {
+  int node = 0;
+  Dof dof = Dof::UX;
+};
+
+/// Parses a DOF table held in memory ("node, dof" per line, blanks or commas; dof ux..rz or 1..6; an optional
+/// header line; '#' and '%' lines are comments). `name` names it in messages.
+std::vector<DofRow> parse_dof_table(const std::string& text, const std::string& name);
+/// Parses a node table held in memory ("id, x, y[, z]" per line; an optional header line).
+std::vector<Node> parse_node_table(const std::string& text, const std::string& name);
+
+/// One element of an element-matrices file.
+struct ElementMatrices {
+  int id = 0;
+  std::string group;
+  std::vector<int> nodes;      ///< optional "nodes" record: the nodes it connects (for geometry)
+  std::vector<int> equations;  ///< 0-based global equations, in matrix order
+  Eigen::MatrixXd K, M;        ///< full symmetric storage
+  int line = 0;                ///< line of its "element" record
+};
+
+/// Parses an element-matrices file held in memory; `name` names it in messages ("file:line: ...").
+/// `num_equations` bounds the equation numbers (rows of the DOF table).
+std::vector<ElementMatrices> parse_element_matrices(const std::string& text, const std::string& name, int num_equations);
+
+/// Adds the nodes and Matrix elements of a matrix model to `model` (not finalized: the caller may add supports,
+/// springs, point masses, then finalize). Remarks (e.g. a remainder element) go to `notes` if not null. Throws
+/// InputError naming file and line for anything malformed or inconsistent.
+void add_matrix_model(const MatrixModelFiles& files, Model* model, std::vector<std::string>* notes = nullptr);
+
+/// Writes `model` (finalized) as a matrix model into folder `dir` (created if missing): K.mtx, M.mtx (assembled,
+/// symmetric), dofs.csv, nodes.csv, elements.txt (one record per element) and model.yaml (the case-file model
+/// section that reads them back). Refuses to replace existing files unless `overwrite`. Returns the paths written.
+std::vector<std::string> write_matrix_model(const Model& model, const std::string& dir, bool overwrite);
+
+}  // namespace dynid
