@@ -8,6 +8,7 @@
 #include "dynid/engine/detect.hpp"
 #include "dynid/io/case_file.hpp"
 #include "dynid/io/modal_data_io.hpp"
+#include "dynid/io/model_plots.hpp"
 #include "dynid/io/output.hpp"
 #include "dynid/io/plot.hpp"
 #include "dynid/mesh/error.hpp"
@@ -78,7 +79,7 @@ plot::Figure summary_figure(const Case& c, const Model& model, const DetectSumma
         flagged_nodes.push_back(model.nodes()[en[q]].id);
     }
   plot::Panel p1;
-  p1.title = S.full_dofs ? "Pseudo residual force per DOF (eq. 7-8), all DOFs" : "Pseudo residual force per measured DOF (SEREP-reduced model)";
+  p1.title = S.full_dofs ? "Pseudo residual force per DOF (eq. 7-8)" : "Pseudo residual per measured DOF (SEREP)";
   p1.ylabel = "|r| (geometric mean over modes)";
   p1.log_y = true;
   plot::Series in, out;
@@ -100,7 +101,7 @@ plot::Figure summary_figure(const Case& c, const Model& model, const DetectSumma
   p2.title = "Pseudo residual force mapped to elements (paper)";
   p2.ylabel = "element score";
   p2.log_y = true;
-  p3.title = S.full_dofs ? "dynid: share of the residual force each element explains alone" : "dynid: probability that the element alone changed";
+  p3.title = S.full_dofs ? "dynid: share each element explains alone" : "dynid: probability the element alone changed";
   p3.ylabel = S.full_dofs ? "explained fraction" : "probability";
   p3.xlabel = "element id";
   plot::Series a2, b2, a3, b3;
@@ -116,7 +117,43 @@ plot::Figure summary_figure(const Case& c, const Model& model, const DetectSumma
   }
   p2.series = {a2, b2};
   p3.series = {a3, b3};
-  f.panels = {p1, p2, p3};
+  // The same localization as a map on the structure.
+  std::vector<std::pair<int, double>> values;
+  std::vector<int> hits;
+  for (const ElementScore& e : S.elements) {
+    values.emplace_back(e.element, e.probability);
+    if (e.flagged) hits.push_back(e.element);
+  }
+  plot::Panel p4 = plot::element_map_panel(model, values, hits, std::string("Localization on the structure (width: ") +
+                                                                     (S.full_dofs ? "share" : "probability") + ")");
+  // Frequencies and MAC of the paired modes: the model (reference state) against the changed structure.
+  plot::Panel p5, p6;
+  p5.title = "Frequency change per mode (changed vs model)";
+  p5.ylabel = "change [%]";
+  p5.xlabel = "mode";
+  p6.title = "MAC per mode (changed vs model)";
+  p6.ylabel = "MAC";
+  p6.xlabel = "mode";
+  plot::Series df, mac;
+  df.kind = plot::Kind::kBars;
+  mac.kind = plot::Kind::kLineMarkers;
+  df.color = mac.color = 0;
+  for (Eigen::Index k = 0; k < S.model_hz.size() && k < S.changed_hz.size(); ++k) {
+    df.x.push_back(static_cast<double>(k + 1));
+    df.y.push_back(100.0 * (S.changed_hz[k] / S.model_hz[k] - 1.0));
+    if (k < S.mac.size()) {
+      mac.x.push_back(static_cast<double>(k + 1));
+      mac.y.push_back(S.mac[k]);
+    }
+  }
+  p5.series = {df};
+  p6.series = {mac};
+  p5.legend = p6.legend = false;
+  f.rows = 3;
+  f.cols = 2;
+  f.width = 1800;
+  f.height = 1700;
+  f.panels = {p1, p4, p2, p3, p5, p6};
   return f;
 }
 
@@ -201,6 +238,10 @@ int run_detect(const DetectArgs& a, const GlobalOptions& g) {
 }
 
 }  // namespace
+
+int detect_step(const std::string& case_path, const std::string& json, const std::string& plot, bool force, const GlobalOptions& g) {
+  return run_detect(DetectArgs{case_path, json, plot, false, force}, g);
+}
 
 void register_detect(CLI::App& app, GlobalOptions& g) {
   auto a = std::make_shared<DetectArgs>();

@@ -121,6 +121,10 @@ int run_discover(const DiscoverArgs& a, const GlobalOptions& g) {
 
 }  // namespace
 
+int discover_step(const std::string& case_path, const std::string& json, const std::string& plot, bool force, const GlobalOptions& g) {
+  return run_discover(DiscoverArgs{case_path, json, plot, 0, force}, g);
+}
+
 void register_discover(CLI::App& app, GlobalOptions& g) {
   auto a = std::make_shared<DiscoverArgs>();
   CLI::App* cmd = app.add_subcommand("discover", "Find what physics the model leaves out: locate the mismatch, fit candidate effects, report");

@@ -2,6 +2,7 @@
 // output-only recordings). dynid simulate-test CASE : a virtual test of a case's model, written as UFF 58.
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "commands.hpp"
@@ -231,6 +232,28 @@ int run_simulate(const SimulateArgs& a, const GlobalOptions& g) {
 }
 
 }  // namespace
+
+int test_step(const std::string& case_path, const std::string& dir, bool force, const GlobalOptions& g) {
+  const Case c = load_case(case_path);
+  require_section(c, c.test.has_value(), "test");
+  const std::string uff = (fs::path(dir) / "test.uff").string();
+  if (const int rc = run_simulate(SimulateArgs{case_path, uff, force}, g); rc != 0) return rc;
+  IdentifyArgs a;
+  for (const auto& f : fs::directory_iterator(dir)) {  // test.uff, or test-<input>.uff per hit location
+    const std::string name = f.path().filename().string();
+    if (name.rfind("test", 0) == 0 && f.path().extension() == ".uff") a.files.push_back(f.path().string());
+  }
+  std::sort(a.files.begin(), a.files.end());
+  const IdentificationOptions& io = c.test->identify;
+  if (io.band_hi_hz > 0) a.band = {io.band_lo_hz, io.band_hi_hz};
+  if (io.max_order > 0) a.orders = {static_cast<double>(io.min_order), static_cast<double>(io.max_order)};
+  a.method = c.test->method;
+  a.json = (fs::path(dir) / "identify.json").string();
+  a.uff = (fs::path(dir) / "identify-modes.uff").string();
+  a.plot = (fs::path(dir) / "identify.png").string();
+  a.force = force;
+  return run_identify(a, g);
+}
 
 void register_identify(CLI::App& app, GlobalOptions& g) {
   auto a = std::make_shared<IdentifyArgs>();

@@ -6,6 +6,7 @@
 #include "dynid/engine/modal.hpp"
 #include "dynid/io/case_file.hpp"
 #include "dynid/io/matrix_model.hpp"
+#include "dynid/io/model_plots.hpp"
 #include "dynid/io/output.hpp"
 #include "progress.hpp"
 
@@ -15,7 +16,7 @@ namespace {
 struct ModalArgs {
   std::string case_path;
   int modes = 0;
-  std::string json;
+  std::string json, plot;
   bool force = false;
 };
 
@@ -53,7 +54,9 @@ int run_modal(const ModalArgs& a, const GlobalOptions& g) {
     }
     if (g.verbose) fmt::print("{}", r.summary.FullReport());
   }
+  if (!a.plot.empty()) refuse_existing({a.plot}, a.force);
   if (!a.json.empty()) write_file_atomic(a.json, modal_json(c, r).dump(1) + "\n", a.force);
+  if (!a.plot.empty()) plot::save(plot::mode_shape_figure(c.model, r, 6, "dynid modal: " + c.name + " - mode shapes"), a.plot, a.force);
   if (!r.ok()) {
     fmt::print(stderr, "dynid modal: {}\n", r.summary.BriefReport());
     return 1;
@@ -62,6 +65,10 @@ int run_modal(const ModalArgs& a, const GlobalOptions& g) {
 }
 }  // namespace
 
+int modal_step(const std::string& case_path, const std::string& json, const std::string& plot, bool force, const GlobalOptions& g) {
+  return run_modal(ModalArgs{case_path, 0, json, plot, force}, g);
+}
+
 void register_modal(CLI::App& app, GlobalOptions& g) {
   auto a = std::make_shared<ModalArgs>();
   CLI::App* cmd = app.add_subcommand("modal", "Modal analysis: the lowest modes (or a band) of a case's model");
@@ -69,6 +76,7 @@ void register_modal(CLI::App& app, GlobalOptions& g) {
   cmd->add_option("--modes", a->modes, "Number of lowest modes, rigid-body modes included (overrides the case)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--json", a->json, "Write the results as JSON to FILE");
+  cmd->add_option("--plot", a->plot, "Draw the first six elastic mode shapes on the structure to FILE (.png or .svg)");
   cmd->add_flag("--force", a->force, "Overwrite existing output files");
   cmd->callback([a, &g]() { g.exit_code = run_guarded("modal", [&] { return run_modal(*a, g); }); });
 

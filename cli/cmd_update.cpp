@@ -163,6 +163,10 @@ int run_update(const UpdateArgs& a, const GlobalOptions& g) {
 
 }  // namespace
 
+int update_step(const std::string& case_path, const std::string& json, const std::string& plot, bool force, const GlobalOptions& g) {
+  return run_update(UpdateArgs{case_path, json, plot, force}, g);
+}
+
 void register_update(CLI::App& app, GlobalOptions& g) {
   auto a = std::make_shared<UpdateArgs>();
   CLI::App* cmd = app.add_subcommand("update", "FE model updating: fit physical parameters to measured modes (Ceres)");

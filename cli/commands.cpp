@@ -34,6 +34,7 @@ void register_commands(CLI::App& app, GlobalOptions& g) {
   register_identify(app, g);
   register_info(app, g);
   register_discover(app, g);
+  register_run(app, g);
 }
 
 }  // namespace dynid::cli

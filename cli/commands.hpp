@@ -26,5 +26,16 @@ void register_update(CLI::App& app, GlobalOptions& g);
 void register_identify(CLI::App& app, GlobalOptions& g);  // identify and simulate-test
 void register_info(CLI::App& app, GlobalOptions& g);
 void register_discover(CLI::App& app, GlobalOptions& g);
+void register_run(CLI::App& app, GlobalOptions& g);  // run and report
+
+/// One step of a case, as its subcommand does it, writing the results JSON and the figure (PNG) to the given
+/// paths; returns the subcommand's exit code. `dynid run` chains them.
+int modal_step(const std::string& case_path, const std::string& json, const std::string& plot, bool force, const GlobalOptions& g);
+int detect_step(const std::string& case_path, const std::string& json, const std::string& plot, bool force, const GlobalOptions& g);
+int update_step(const std::string& case_path, const std::string& json, const std::string& plot, bool force, const GlobalOptions& g);
+/// A case's test: section: simulate-test into `dir` (test*.uff), then identify those recordings with the case's
+/// identification options (identify.json, identify-modes.uff, identify.png: the stabilization diagram).
+int test_step(const std::string& case_path, const std::string& dir, bool force, const GlobalOptions& g);
+int discover_step(const std::string& case_path, const std::string& json, const std::string& plot, bool force, const GlobalOptions& g);
 
 }  // namespace dynid::cli

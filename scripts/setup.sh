@@ -13,6 +13,7 @@ packages=(
   libopenblas-dev liblapack-dev libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libyaml-cpp-dev libcli11-dev libfmt-dev libfftw3-dev
   libplplot-dev plplot-driver-cairo
+  chromium  # scripts/check-report.sh: the report checked in a headless browser (ctest report.browser)
   clang libclang-rt-14-dev libomp-dev  # scripts/sanitize.sh, fuzz.sh: clang, libFuzzer, sanitizer run-times, OpenMP
   python3 python3-numpy python3-scipy python3-slepc4py python3-petsc4py
 )

@@ -183,6 +183,9 @@ void draw_panel(const Panel& p, double vx0, double vx1, double vy0, double vy1) 
     const double base = p.log_y ? y0 : std::max(y0, std::min(0.0, y1));
     switch (s.kind) {
       case Kind::kLine: plline(n, xs.data(), ys.data()); break;
+      case Kind::kSegments:
+        for (PLINT i = 0; i + 1 < n; i += 2) plline(2, &xs[i], &ys[i]);
+        break;
       case Kind::kMarkers:
         plssym(0, s.symbol_scale);
         plpoin(n, xs.data(), ys.data(), s.symbol);

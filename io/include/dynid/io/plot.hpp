@@ -8,7 +8,8 @@
 
 namespace dynid::plot {
 
-enum class Kind { kLine, kMarkers, kLineMarkers, kBars, kStems };
+/// kSegments: separate line segments between points 0-1, 2-3, ... (a structure drawn member by member).
+enum class Kind { kLine, kMarkers, kLineMarkers, kBars, kStems, kSegments };
 
 struct Series {
   std::string label;
