@@ -59,6 +59,21 @@ struct Member {
   double L = 0, EI = 0, GA = 0, rhoA = 0, rhoI = 0;
 };
 
+// The mass an element moves in a rigid translation, largest over x, y, z (r^T M r with r = 1 on the element's
+// DOFs of that direction): the mass of a matrix element, which has no section to compute it from.
+double translational_mass(const Model& model, int e) {
+  const auto types = model.element_dof_types(e);
+  Eigen::MatrixXd M;
+  model.element_matrices(e, nullptr, &M);
+  double best = 0;
+  for (int d = 0; d < 3; ++d) {
+    Eigen::VectorXd r = Eigen::VectorXd::Zero(M.rows());
+    for (std::size_t i = 0; i < types.size(); ++i) r[static_cast<Eigen::Index>(i)] = static_cast<int>(types[i].second) == d ? 1.0 : 0.0;
+    best = std::max(best, r.dot(M * r));
+  }
+  return best;
+}
+
 Member member(const Model& model, int e) {
   Member m;
   m.e = e;
@@ -510,6 +525,7 @@ std::vector<std::unique_ptr<Candidate>> library(const Model& model, const ModalD
   for (int e = 0; e < model.num_elements(); ++e) {
     for (int k = 0; k < model.elements()[e].num_nodes; ++k) used[model.element_nodes(e)[k]] = 1;
     if (model.elements()[e].type == ElementType::PointMass) mass += model.elements()[e].mass;
+    if (model.elements()[e].type == ElementType::Matrix) mass += translational_mass(model, e);
     if (!is_member(model, e)) continue;
     for (int k = 0; k < 2; ++k) ends[model.element_nodes(e)[k]].push_back({e, k});
     const Member mb = member(model, e);
