@@ -165,6 +165,37 @@ TEST(EdgeCases, RigidBodyModesBesideNearZeroElasticModes) {
   EXPECT_LT(G.cwiseAbs().maxCoeff(), 1e-10);
 }
 
+// A model with fewer free DOFs than rigid-body motions (found by fuzz_case: the support check read past the
+// singular values, an out-of-bounds read): one inclined member, clamped at one end, only ux free at the other.
+// The check must pass (ux is held by the member) and the single eigenvalue is K/M of that DOF (1e-12: a 1x1
+// problem, rounding only).
+TEST(EdgeCases, FewerFreeDofsThanRigidMotions) {
+  Model m;
+  m.add_node(1, {0, 0, 0});
+  m.add_node(2, {1, 1, 0});
+  m.add_material({"steel", 2.1e11, 0, 0.3, 7800});
+  m.add_section({"s", 1e-4, 0, 1e-8, 0, 0});
+  Element e;
+  e.id = 1;
+  e.type = ElementType::Frame2D;
+  e.node_ids = {{1, 2}};
+  e.material = e.section = 0;
+  m.add_element(e);
+  m.restrain(1, kAllDofs);
+  m.restrain(2, dof_bit(Dof::UY) | dof_bit(Dof::RZ));
+  ASSERT_NO_THROW(m.finalize());
+  ASSERT_EQ(m.num_dofs(), 1);
+  EXPECT_EQ(m.rigid_body_motions().cols(), 2);  // translation x and rotation about z touch the free ux
+  EXPECT_EQ(m.free_rigid_body_modes().cols(), 0);
+  SparseMatrix K, M;
+  Assembler(m).assemble(&K, &M);
+  EigenOptions o;
+  o.num_modes = 1;
+  const ModalResult r = modal_analysis(m, o);
+  ASSERT_TRUE(r.ok());
+  EXPECT_TRUE(test::RelClose(r.eigenvalues[0], K.coeff(0, 0) / M.coeff(0, 0), 1e-12));
+}
+
 TEST(EdgeCases, SerepWithMoreModesThanMastersAndDependentShapes) {
   const Case c = load_case(test::CasesDir() + "/paper-beam");
   EigenOptions o;

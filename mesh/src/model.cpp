@@ -380,11 +380,18 @@ Eigen::MatrixXd Model::free_rigid_body_modes(std::vector<std::string>* descripti
   }
   constexpr double tol = 1e-10;
   const double scale = Ya.norm() / std::sqrt(static_cast<double>(nc));
-  // Dimension of the free subspace: combinations R v with ||K R v|| at rounding level.
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Y, Eigen::ComputeFullV);
+  // The motions may be dependent on the free DOFs (a tiny model: fewer free DOFs than motions), so work in an
+  // orthonormal basis Q = R W of their span (W = V_r / s_r from the SVD of R; rank by rounding level), and
+  // find the combinations Q u with ||K Q u|| = ||Y W u|| at rounding level.
+  const Eigen::JacobiSVD<Eigen::MatrixXd> rsvd(R, Eigen::ComputeThinV);
+  Eigen::Index rank = 0;
+  while (rank < rsvd.singularValues().size() && rsvd.singularValues()[rank] > 1e-12 * rsvd.singularValues()[0]) ++rank;
+  const Eigen::MatrixXd W = rsvd.matrixV().leftCols(rank) * rsvd.singularValues().head(rank).cwiseInverse().asDiagonal();
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Y * W, Eigen::ComputeFullV);
   std::vector<Eigen::Index> null;
-  for (Eigen::Index i = 0; i < nc; ++i)
-    if (svd.singularValues()[i] <= tol * scale) null.push_back(i);
+  const Eigen::Index ns = svd.singularValues().size();
+  for (Eigen::Index i = 0; i < rank; ++i)
+    if (i >= ns || svd.singularValues()[i] <= tol * scale) null.push_back(i);
   // Prefer the individual motions (translation x, rotation about z, ...) when they span the free subspace.
   std::vector<Eigen::Index> single;
   for (Eigen::Index c = 0; c < nc; ++c)
@@ -397,7 +404,7 @@ Eigen::MatrixXd Model::free_rigid_body_modes(std::vector<std::string>* descripti
     }
   } else {
     for (std::size_t k = 0; k < null.size(); ++k) {
-      Eigen::VectorXd v = svd.matrixV().col(null[k]);
+      const Eigen::VectorXd v = W * svd.matrixV().col(null[k]);
       N.col(static_cast<Eigen::Index>(k)) = R * v;
     }
     if (descriptions) {
