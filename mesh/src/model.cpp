@@ -185,6 +185,8 @@ void Model::finalize_matrix_element(int k, std::vector<DofMask>* active) {
   const Element& e = elements_[k];
   const std::string who = elem_label(e);
   if (!e.matrix) throw InputError(who + ": no matrices given");
+  if (e.num_nodes < 0 || e.num_nodes > 2)
+    throw InputError(who + ": num_nodes must be 0, 1 or 2 (the ends drawn); build it with make_matrix_element()");
   const MatrixElementData& d = *e.matrix;
   const Eigen::Index n = static_cast<Eigen::Index>(d.dofs.size());
   if (n == 0) throw InputError(who + ": has no DOFs");
