@@ -200,7 +200,7 @@ int run_detect(const DetectArgs& a, const GlobalOptions& g) {
   const ModalData changed = detect_changed_data(c, &changed_m);
   if (!d.changes.empty()) opt.simulated_changed = &changed_m;
   ModalData refmeas;
-  if (!d.reference_measured_file.empty()) refmeas = read_modal_data(d.reference_measured_file);
+  if (!d.reference_measured_file.empty()) refmeas = read_measured_modal_data(d.reference_measured_file, d.geometry, model);
   progress.update("detect", -1);
   const DetectSummary S = detect(model, changed, opt, d.reference_measured_file.empty() ? nullptr : &refmeas);
   progress.done();

@@ -48,12 +48,16 @@ DiscoverSpec::Expect parse_expect(const YAML::Node& n, const YamlCtx& ctx, bool 
 
 DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir) {
   ctx.require_map(n, "discover");
-  ctx.only_keys(n, "discover", {"measured", "recordings", "identify", "truth", "modes", "min_mpc", "frequency_noise", "shape_noise",
+  ctx.only_keys(n, "discover", {"measured", "geometry", "recordings", "identify", "truth", "modes", "min_mpc", "frequency_noise", "shape_noise",
                                 "kinds", "sensor_nodes", "suspension_nodes", "max_effects", "screen", "seeds", "expect", "units"});
   DiscoverSpec d;
   const int sources = !!n["measured"] + !!n["recordings"] + !!n["truth"];
   if (sources != 1) ctx.fail(n, "discover: give exactly one of measured: FILE (modal data), recordings: [FILES] or truth: {model:, test:}");
   if (n["measured"]) d.measured_file = resolve(dir, ctx.string(n["measured"], "discover measured"));
+  if (n["geometry"]) {
+    if (!n["measured"]) ctx.fail(n["geometry"], "discover: geometry ties the measured file to the model; it needs measured:");
+    d.geometry = parse_geometry(n["geometry"], ctx, dir);
+  }
   if (n["recordings"]) {
     const YAML::Node& r = n["recordings"];
     if (r.IsScalar()) d.recordings.push_back(resolve(dir, ctx.string(r, "discover recordings")));
@@ -168,9 +172,7 @@ DiscoveryData discovery_data(const Case& c, int seed_offset) {
   const DiscoverSpec& d = *c.discover;
   DiscoveryData out;
   if (!d.measured_file.empty()) {
-    const std::string ext = fs::path(d.measured_file).extension().string();
-    if (ext == ".json") out.measured = read_modal_data(d.measured_file);
-    else out.measured = uff_modal_data(read_uff(d.measured_file));
+    out.measured = read_measured_modal_data(d.measured_file, d.geometry, c.model, &out.notes);
     out.source = d.measured_file;
   } else {
     std::vector<Recording> recs;

@@ -6,6 +6,7 @@
 
 #include "dynid/engine/modal.hpp"
 #include "dynid/io/modal_data_io.hpp"
+#include "dynid/io/point_map.hpp"
 #include "internal/case_util.hpp"
 #include "internal/file_util.hpp"
 #include "internal/model_yaml.hpp"
@@ -63,6 +64,28 @@ std::vector<MeasuredDof> parse_dof_selection(const YAML::Node& n, const YamlCtx&
     ctx.fail(n, what + ": " + e.what());
   }
   return out;
+}
+
+GeometrySpec parse_geometry(const YAML::Node& n, const YamlCtx& ctx, const std::string& dir) {
+  GeometrySpec g;
+  if (n.IsScalar()) {
+    g.file = resolve(dir, ctx.string(n, "geometry"));
+    return g;
+  }
+  ctx.require_map(n, "geometry");
+  ctx.only_keys(n, "geometry", {"file", "match", "tolerance"});
+  if (!n["file"]) ctx.fail(n, "geometry: 'file' is missing (a UFF file with the test points, dataset 15 or 2411)");
+  g.file = resolve(dir, ctx.string(n["file"], "geometry file"));
+  if (n["match"]) {
+    const std::string m = ctx.string(n["match"], "geometry match");
+    if (m != "position" && m != "id") ctx.fail(n["match"], "geometry: match must be position or id, got '" + m + "'");
+    g.by_position = m == "position";
+  }
+  if (n["tolerance"]) {
+    g.tolerance = ctx.number(n["tolerance"], "geometry tolerance");
+    if (!(g.tolerance > 0)) ctx.fail(n["tolerance"], "geometry: tolerance must be > 0 (model length units)");
+  }
+  return g;
 }
 
 std::string resolve(const std::string& dir, const std::string& file) {
@@ -152,7 +175,7 @@ void parse_noise(const YAML::Node& n, const YamlCtx& ctx, DetectOptions* o) {
 
 DetectSpec parse_detect(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir) {
   ctx.require_map(n, "detect");
-  ctx.only_keys(n, "detect", {"modes", "changed", "measured", "reference_measured", "measured_dofs", "noise",
+  ctx.only_keys(n, "detect", {"modes", "changed", "measured", "reference_measured", "geometry", "measured_dofs", "noise",
                               "significance", "max_changed", "refine", "serep_modes", "min_mac", "candidates", "study"});
   DetectSpec d;
   DetectOptions& o = d.options;
@@ -182,6 +205,10 @@ DetectSpec parse_detect(const YAML::Node& n, const YamlCtx& ctx, const Model& mo
     if (n["measured_dofs"]) ctx.fail(n["measured_dofs"], "detect: measured_dofs is for simulations; measured data carry their own DOFs");
   }
   if (n["reference_measured"]) d.reference_measured_file = resolve(dir, ctx.string(n["reference_measured"], "reference_measured"));
+  if (n["geometry"]) {
+    if (!n["measured"]) ctx.fail(n["geometry"], "detect: geometry ties measured files to the model; it needs measured:");
+    d.geometry = parse_geometry(n["geometry"], ctx, dir);
+  }
   if (n["noise"]) parse_noise(n["noise"], ctx, &o);
   if (n["significance"]) o.significance = ctx.number(n["significance"], "significance");
   if (!(o.significance > 0 && o.significance < 1)) ctx.fail(n["significance"], "detect: significance must be in (0, 1)");
@@ -282,7 +309,7 @@ ModalData simulate(const Model& m, const std::vector<MeasuredDof>& dofs, int cou
 ModalData detect_changed_data(const Case& c, Model* changed) {
   require_section(c, c.detect.has_value(), "detect");
   const DetectSpec& d = *c.detect;
-  if (!d.measured_file.empty()) return read_modal_data(d.measured_file);
+  if (!d.measured_file.empty()) return read_measured_modal_data(d.measured_file, d.geometry, c.model);
   Model local;
   Model& m = changed ? *changed : local;  // the caller may not want the changed model
   m = changed_model(c.model, d.changes);
@@ -293,7 +320,7 @@ ModalData update_measured_data(const Case& c) {
   require_section(c, c.update.has_value(), "update");
   const UpdateSpec& u = *c.update;
   ModalData m = !u.measured_file.empty()
-                    ? read_modal_data(u.measured_file)
+                    ? read_measured_modal_data(u.measured_file, u.geometry, c.model)
                     : simulate(apply_factors(c.model, u.target_changes), u.measured_dofs, u.target_modes,
                                "simulated target of " + c.name);
   if (u.modes > 0 && u.modes < m.num_modes()) {

@@ -42,13 +42,17 @@ std::vector<int> element_list(const YAML::Node& n, const YamlCtx& ctx, const Mod
 
 UpdateSpec parse_update(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir) {
   ctx.require_map(n, "update");
-  ctx.only_keys(n, "update", {"measured", "target", "modes", "objective", "parameters", "noise", "regularization",
+  ctx.only_keys(n, "update", {"measured", "geometry", "target", "modes", "objective", "parameters", "noise", "regularization",
                               "loss", "loss_scale", "solver", "max_iterations", "min_mac", "extra_modes"});
   UpdateSpec u;
   FitOptions& o = u.options;
   if (n["measured"] && n["target"]) ctx.fail(n, "update: give either measured: (a file) or target: (a simulation), not both");
   if (!n["measured"] && !n["target"]) ctx.fail(n, "update: the measured data are missing: give measured: FILE or target: {...}");
   if (n["measured"]) u.measured_file = resolve(dir, ctx.string(n["measured"], "measured"));
+  if (n["geometry"]) {
+    if (!n["measured"]) ctx.fail(n["geometry"], "update: geometry ties the measured file to the model; it needs measured:");
+    u.geometry = internal::parse_geometry(n["geometry"], ctx, dir);
+  }
   if (n["target"]) {
     const YAML::Node& t = n["target"];
     ctx.require_map(t, "target");

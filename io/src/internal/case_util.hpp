@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "dynid/engine/modal_data.hpp"
+#include "dynid/io/point_map.hpp"
 #include "internal/yaml_util.hpp"
 
 namespace dynid::internal {
@@ -14,6 +15,8 @@ std::vector<MeasuredDof> parse_dof_selection(const YAML::Node& n, const YamlCtx&
                                              const std::string& what);
 /// A path relative to the case file's folder (absolute paths unchanged).
 std::string resolve(const std::string& dir, const std::string& file);
+/// geometry: FILE | {file: FILE, match: position | id, tolerance: T} (beside measured:).
+GeometrySpec parse_geometry(const YAML::Node& n, const YamlCtx& ctx, const std::string& dir);
 
 }  // namespace dynid::internal
 

@@ -14,6 +14,7 @@
 #include "dynid/engine/identify.hpp"
 #include "dynid/engine/virtual_test.hpp"
 #include "dynid/engine/model_fit.hpp"
+#include "dynid/io/point_map.hpp"
 #include "dynid/engine/parametric.hpp"
 #include "dynid/mesh/model.hpp"
 #include "dynid/solvers/eigen.hpp"
@@ -36,6 +37,7 @@ struct DetectSpec {
   std::vector<std::pair<int, std::pair<double, double>>> changes;  ///< element id -> (dk, dm)
   std::string measured_file;            ///< changed-state modal data (JSON) instead of `changes`
   std::string reference_measured_file;  ///< optional reference-state modal data
+  GeometrySpec geometry;                ///< test geometry tying the measured files' points to model nodes
   std::vector<MeasuredDof> measured_dofs;  ///< DOFs the simulated changed state is "measured" at
   DetectOptions options;
   bool has_study = false;
@@ -46,6 +48,7 @@ struct DetectSpec {
 /// simulated target: the model with element factors changed, sampled at `measured_dofs`).
 struct UpdateSpec {
   std::string measured_file;
+  GeometrySpec geometry;  ///< test geometry tying the measured file's points to model nodes
   std::vector<std::pair<int, PropertyFactors>> target_changes;  ///< simulated target
   std::vector<MeasuredDof> measured_dofs;
   int target_modes = 5;                  ///< elastic modes of the simulated target
@@ -73,6 +76,7 @@ struct TestSpec {
 /// the discovery options, and optionally what the answer should be (`expect`, for the test suite).
 struct DiscoverSpec {
   std::string measured_file;               ///< UFF 55 or modal-data JSON
+  GeometrySpec geometry;                   ///< test geometry tying the measured file's points to model nodes
   std::vector<std::string> recordings;     ///< UFF 58 / text recordings, identified first
   std::string method;                      ///< identification method for recordings ("" = by the data)
   IdentificationOptions identify;
