@@ -33,7 +33,7 @@ int main(int argc, char** argv) {
   using namespace dynid::cli;
   dynid::ensure_blas_kernels(argv);
   CLI::App app{"dynid: finds where a structure differs from its finite-element model, and why, from vibration "
-               "measurements.\nExit codes: 0 success, 1 numerical failure, 2 bad input or usage, 3 internal error."};
+               "measurements.\nExit codes: 0 success, 1 numerical failure, 2 bad input or usage, 3 internal error, 4 a discovery case's expect: not met (discover, run)."};
   app.set_version_flag("--version", std::string("dynid ") + DYNID_VERSION);
   app.require_subcommand(1);
   app.fallthrough();  // global options may follow the subcommand
