@@ -49,7 +49,7 @@ int run_case(const RunArgs& a, const GlobalOptions& g) {
     outputs.push_back((fs::path(dir) / (name + ".png")).string());
   }
   if (a.report) outputs.push_back(report_path(dir));
-  for (const std::string& p : outputs) refuse_existing({p}, a.force);  // nothing is written if anything would be lost
+  refuse_existing(outputs, a.force);  // nothing is written if anything would be lost
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw InputError(dir + ": cannot create the results folder (" + ec.message() + ")");

@@ -12,7 +12,7 @@
 #include "dynid/io/mesh_files.hpp"
 #include "dynid/io/limits.hpp"
 #include "dynid/mesh/error.hpp"
-#include "internal/file_util.hpp"
+#include "internal/text_util.hpp"
 #include "internal/sections.hpp"
 
 namespace dynid {

@@ -8,7 +8,7 @@
 #include "dynid/io/modal_data_io.hpp"
 #include "dynid/io/point_map.hpp"
 #include "internal/case_util.hpp"
-#include "internal/file_util.hpp"
+#include "internal/text_util.hpp"
 #include "internal/model_yaml.hpp"
 
 namespace dynid {

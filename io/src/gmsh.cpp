@@ -9,7 +9,7 @@
 
 #include "dynid/io/mesh_files.hpp"
 #include "dynid/mesh/error.hpp"
-#include "internal/file_util.hpp"
+#include "internal/text_util.hpp"
 
 namespace dynid {
 

@@ -10,7 +10,7 @@
 
 #include "dynid/io/output.hpp"
 #include "dynid/mesh/error.hpp"
-#include "internal/file_util.hpp"
+#include "internal/text_util.hpp"
 
 namespace dynid {
 

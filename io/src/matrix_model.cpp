@@ -348,7 +348,7 @@ std::vector<std::string> write_matrix_model(const Model& model, const std::strin
   const std::vector<std::string> paths = {(d / "K.mtx").string(), (d / "M.mtx").string(), (d / "dofs.csv").string(),
                                           (d / "nodes.csv").string(), (d / "elements.txt").string(),
                                           (d / "model.yaml").string()};
-  for (const std::string& p : paths) refuse_existing({p}, overwrite);
+  refuse_existing(paths, overwrite);
   std::error_code ec;
   fs::create_directories(d, ec);
   if (ec) throw InputError(dir + ": cannot create the folder (" + ec.message() + ")");

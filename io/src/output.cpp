@@ -9,33 +9,20 @@
 #include <sstream>
 
 #include "dynid/mesh/error.hpp"
-#include "internal/file_util.hpp"
 
 namespace dynid {
 
 namespace fs = std::filesystem;
 
-std::string internal::read_file_bytes(const std::string& path) {
-  // Only regular files: a device (/dev/zero) or a FIFO named by a hostile input would never end.
-  std::error_code ec;
-  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec)) throw InputError(path + ": not a regular file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open for reading");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void refuse_existing(std::initializer_list<std::string> paths, bool overwrite) {
+void refuse_existing(const std::vector<std::string>& paths, bool overwrite) {
   std::error_code ec;
   for (const std::string& p : paths)
-    if (!overwrite && fs::exists(p, ec)) throw InputError(p + ": file exists; pass --force to overwrite it");
+    if (!overwrite && fs::exists(p, ec)) throw InputError(p + ": file exists; pass --force to overwrite it, or choose another name");
 }
 
 void write_file_atomic(const std::string& path, const std::string& content, bool overwrite) {
+  refuse_existing({path}, overwrite);
   std::error_code ec;
-  if (!overwrite && fs::exists(path, ec))
-    throw InputError(path + ": file exists; pass --force to overwrite it, or choose another name");
   const fs::path target(path);
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   if (!fs::is_directory(dir, ec)) throw InputError(path + ": folder '" + dir.string() + "' does not exist");

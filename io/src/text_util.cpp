@@ -15,6 +15,9 @@ namespace dynid::internal {
 std::string read_file_bytes(const std::string& path, std::size_t max_bytes) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a folder, not a file");
+  // Only regular files: a device (/dev/zero) or a FIFO named by a hostile input would never end.
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    throw InputError(path + ": not a regular file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the file (does it exist and is it readable?)");
   in.seekg(0, std::ios::end);

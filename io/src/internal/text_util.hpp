@@ -8,8 +8,8 @@
 
 namespace dynid::internal {
 
-/// Reads a whole file as bytes. Throws InputError naming the path if it cannot be opened, is a folder, or is
-/// larger than `max_bytes`.
+/// Reads a whole file as bytes (every reader goes through it). Throws InputError naming the path if it cannot
+/// be opened, is a folder, a device or a FIFO (which would never end), or is larger than `max_bytes`.
 std::string read_file_bytes(const std::string& path, std::size_t max_bytes = std::size_t(1) << 31);
 
 std::string_view trim(std::string_view s);

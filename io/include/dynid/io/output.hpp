@@ -2,7 +2,7 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
-#include <initializer_list>
+#include <vector>
 #include <string>
 
 #include "dynid/engine/modal.hpp"
@@ -17,7 +17,7 @@ void write_file_atomic(const std::string& path, const std::string& content, bool
 
 /// Checks every output of a command before any is written (no partial results): throws InputError for the first
 /// path that exists, unless `overwrite`.
-void refuse_existing(std::initializer_list<std::string> paths, bool overwrite);
+void refuse_existing(const std::vector<std::string>& paths, bool overwrite);
 
 /// The modal results as JSON: {"case", "dofs", "nonzeros", "modes": [{"index", "frequency_hz", "eigenvalue",
 /// "rigid_body", "description"?, "residual"}], "solver": {...}}. See docs/results-json.md.
