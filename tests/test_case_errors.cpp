@@ -36,7 +36,6 @@ std::string Replace(std::string s, const std::string& from, const std::string& t
   return s.replace(p, from.size(), to);
 }
 
-#define EXPECT_HAS(text, part) EXPECT_NE((text).find(part), std::string::npos) << (text)
 
 TEST(CaseErrors, GoodCaseParses) { EXPECT_EQ(Error(kGood), "(no error)"); }
 

@@ -6,6 +6,7 @@
 
 #include "dynid/engine/correlation.hpp"
 #include "dynid/engine/modal.hpp"
+#include "dynid/engine/modal_data.hpp"
 #include "dynid/engine/serep.hpp"
 #include "dynid/io/case_file.hpp"
 #include "dynid/solvers/least_squares.hpp"
@@ -51,9 +52,7 @@ TEST(Serep, ReducedModelReproducesTheModes) {
   o.num_modes = 22;
   o.method = EigenOptions::Method::kDense;
   const ModalResult r = modal_analysis(c.model, o);
-  std::vector<int> masters;
-  for (int i = 0; i < r.dofs; ++i)
-    if (c.model.dof_map().type_of(i) == Dof::UY) masters.push_back(i);
+  const std::vector<int> masters = measured_equations(c.model, dofs_of_types(c.model, dof_bit(Dof::UY)));
   ASSERT_EQ(masters.size(), 11u);
   const SerepReduction s = serep_reduce(r.modes.leftCols(11), r.eigenvalues.head(11), masters);
   EXPECT_EQ(s.rank, 11);
@@ -70,9 +69,7 @@ TEST(Serep, MoreMastersThanModesAndDependentModes) {
   EigenOptions o;
   o.num_modes = 8;
   const ModalResult r = modal_analysis(c.model, o);
-  std::vector<int> masters;
-  for (int i = 0; i < r.dofs; ++i)
-    if (c.model.dof_map().type_of(i) == Dof::UY) masters.push_back(i);
+  const std::vector<int> masters = measured_equations(c.model, dofs_of_types(c.model, dof_bit(Dof::UY)));
   // 11 masters, 6 modes: least squares; the modes are still reproduced.
   const SerepReduction s = serep_reduce(r.modes.leftCols(6), r.eigenvalues.head(6), masters);
   EXPECT_EQ(s.rank, 6);

@@ -9,6 +9,7 @@
 #include "dynid/engine/correlation.hpp"
 #include "dynid/engine/detect.hpp"
 #include "dynid/engine/modal.hpp"
+#include "dynid/engine/modal_data.hpp"
 #include "dynid/engine/model_fit.hpp"
 #include "dynid/engine/serep.hpp"
 #include "dynid/io/case_file.hpp"
@@ -203,9 +204,7 @@ TEST(EdgeCases, SerepWithMoreModesThanMastersAndDependentShapes) {
   const ModalResult r = modal_analysis(c.model, o);
   // 4 masters, 6 modes: the master rows of the modes have rank 4, so the reduced 4 x 4 model keeps 4 modes.
   // Reported (rank, infinite condition), finite matrices, and the kept modes' eigenvalues are no longer exact.
-  std::vector<int> uy;
-  for (int i = 0; i < r.dofs; ++i)
-    if (c.model.dof_map().type_of(i) == Dof::UY) uy.push_back(i);
+  const std::vector<int> uy = measured_equations(c.model, dofs_of_types(c.model, dof_bit(Dof::UY)));
   const std::vector<int> masters(uy.begin(), uy.begin() + 4);
   const SerepReduction s = serep_reduce(r.modes.leftCols(6), r.eigenvalues.head(6), masters);
   EXPECT_EQ(s.rank, 4);

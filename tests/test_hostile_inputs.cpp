@@ -23,7 +23,6 @@ namespace {
 
 using test::ErrorOf;
 
-#define EXPECT_HAS(text, part) EXPECT_NE((text).find(part), std::string::npos) << (text)
 
 using test::Slurp;
 
@@ -106,15 +105,11 @@ namespace fs = std::filesystem;
 
 // A fresh folder holding one earlier result, result.json ("earlier result\n"); removed afterwards.
 struct ResultFolder {
-  explicit ResultFolder(const std::string& tag)
-      : dir(fs::temp_directory_path() / ("dynid-" + tag + "-" + std::to_string(::getpid()))),
-        file((dir / "result.json").string()) {
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+  explicit ResultFolder(const std::string& tag) : scratch(tag), dir(scratch.dir()), file(scratch.path("result.json")) {
     write_file_atomic(file, "earlier result\n", false);
   }
-  ~ResultFolder() { fs::remove_all(dir); }
-  const fs::path dir;
+  const test::ScratchDir scratch;
+  const fs::path& dir;
   const std::string file;
 };
 

@@ -21,7 +21,6 @@ namespace {
 namespace fs = std::filesystem;
 using test::ErrorOf;
 
-#define EXPECT_HAS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << "message: " << (text)
 
 DetectSummary DetectCase(const Case& c) {
   Model changed;
@@ -41,21 +40,15 @@ Eigen::VectorXd Frequencies(const Model& m, int modes = 8) {
 class MatrixFolder : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("dynid-mx-" + std::to_string(::getpid()) + "-" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
     for (const auto& f : fs::directory_iterator(test::CasesDir() + "/paper-frame-matrices"))
-      fs::copy_file(f.path(), dir_ / f.path().filename());
+      fs::copy_file(f.path(), scratch_.dir() / f.path().filename());
   }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string Path(const std::string& f) const { return (dir_ / f).string(); }
-  void Write(const std::string& f, const std::string& text) const { std::ofstream(Path(f)) << text; }
+  std::string Path(const std::string& f) const { return scratch_.path(f); }
+  void Write(const std::string& f, const std::string& text) const { scratch_.write(f, text); }
   Case Load(const std::string& matrices_yaml) const {
-    Write("t.yaml", "name: t\nmodel:\n  matrices:\n" + matrices_yaml + "analysis: {modes: 8}\n");
-    return load_case(Path("t.yaml"));
+    return load_case(scratch_.write("t.yaml", "name: t\nmodel:\n  matrices:\n" + matrices_yaml + "analysis: {modes: 8}\n"));
   }
-  fs::path dir_;
+  const test::ScratchDir scratch_{"mx"};
 };
 
 // Tolerance 1e-10: the files hold 17 significant digits, so the matrices are the frame's to rounding and the

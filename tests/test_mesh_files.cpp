@@ -16,7 +16,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-#define EXPECT_HAS(text, part) EXPECT_NE((text).find(part), std::string::npos) << (text)
 
 std::string MeshDir() { return test::CasesDir() + "/../tests/data/mesh"; }
 

@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 
 #include "dynid/engine/detect.hpp"
 #include "dynid/engine/modal.hpp"
@@ -18,17 +17,12 @@
 namespace dynid {
 namespace {
 
-namespace fs = std::filesystem;
 using test::ErrorOf;
 
-#define EXPECT_HAS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << "message: " << (text)
 
 class PointMap : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("dynid-points-" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
     frame_ = load_case(test::CasesDir() + "/paper-frame-damage/element28-case3.yaml");
     // The damaged frame's first 6 modes at the x and y translations of every free node, labelled with model ids.
     const Model damaged = changed_model(frame_.model, {{28, {-0.15, -0.15}}});
@@ -57,15 +51,13 @@ class PointMap : public ::testing::Test {
     write_uff(Path("points.uff"), geom, true);
     write_uff55(Path("modes.uff"), test, true);
   }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string Path(const std::string& f) const { return (dir_ / f).string(); }
+  std::string Path(const std::string& f) const { return scratch_.path(f); }
   Case Detect(const std::string& measured, const std::string& geometry) const {
     const std::string text = "name: t\nmodel: {include: " + test::CasesDir() + "/paper-frame/case.yaml}\n"
                              "detect:\n  modes: 4\n  measured: " + measured + "\n" + (geometry.empty() ? "" : "  geometry: " + geometry + "\n");
-    std::ofstream(Path("t.yaml")) << text;
-    return load_case(Path("t.yaml"));
+    return load_case(scratch_.write("t.yaml", text));
   }
-  fs::path dir_;
+  const test::ScratchDir scratch_{"points"};
   Case frame_;
   ModalData truth_;
 };

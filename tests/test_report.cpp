@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 
 #include "dynid/io/report.hpp"
 #include "test_util.hpp"
@@ -12,23 +11,14 @@
 namespace dynid {
 namespace {
 
-namespace fs = std::filesystem;
 using test::ErrorOf;
 
-#define EXPECT_HAS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << "message: " << (text)
 
 class Report : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("dynid-report-" + std::to_string(::getpid()) + "-" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  void Write(const std::string& f, const std::string& text) const { std::ofstream(dir_ / f) << text; }
-  std::string Dir() const { return dir_.string(); }
-  fs::path dir_;
+  void Write(const std::string& f, const std::string& text) const { scratch_.write(f, text); }
+  std::string Dir() const { return scratch_.dir().string(); }
+  const test::ScratchDir scratch_{"report"};
 };
 
 TEST_F(Report, MissingKeysGiveDashesNotACrash) {

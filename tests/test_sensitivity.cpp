@@ -6,6 +6,7 @@
 // sensitivity theta/lambda dlambda/dtheta). A plain relative test is not meaningful for derivatives near zero:
 // the finite-difference reference itself carries ~1e-9 absolute noise on lambda from rounding in K(theta)
 // (entries ~1e7 in the frame), which divided by the step is ~1e-7 absolute.
+#include "dynid/engine/modal_data.hpp"
 #include "dynid/engine/parametric.hpp"
 #include "dynid/engine/sensitivity.hpp"
 #include "dynid/io/case_file.hpp"
@@ -107,9 +108,7 @@ TEST(Sensitivity, PaperBeamAgainstFiniteDifferences) {
   pmass.dofs = dof_bit(Dof::UY);
   pmass.nominal = 0.1;
   ps.push_back(pmass);
-  std::vector<int> rows;
-  for (int i = 0; i < c.model.num_dofs(); ++i)
-    if (c.model.dof_map().type_of(i) == Dof::UY) rows.push_back(i);
+  const std::vector<int> rows = measured_equations(c.model, dofs_of_types(c.model, dof_bit(Dof::UY)));
   EigenOptions eo;
   eo.method = EigenOptions::Method::kDense;
   eo.num_modes = c.model.num_dofs();

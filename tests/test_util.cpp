@@ -1,6 +1,8 @@
 #include "test_util.hpp"
 
 #include <Eigen/Dense>
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -22,6 +24,25 @@ std::string Slurp(const std::string& path) {
   std::ostringstream ss;
   ss << in.rdbuf();
   return ss.str();
+}
+
+ScratchDir::ScratchDir(const std::string& tag) {
+  const ::testing::TestInfo* t = ::testing::UnitTest::GetInstance()->current_test_info();
+  dir_ = std::filesystem::temp_directory_path() /
+         ("dynid-" + tag + "-" + std::to_string(::getpid()) + (t ? std::string("-") + t->name() : std::string()));
+  std::filesystem::remove_all(dir_);
+  std::filesystem::create_directories(dir_);
+}
+
+ScratchDir::~ScratchDir() {
+  std::error_code ec;
+  std::filesystem::remove_all(dir_, ec);
+}
+
+std::string ScratchDir::write(const std::string& name, const std::string& text) const {
+  const std::string p = path(name);
+  std::ofstream(p, std::ios::binary) << text;
+  return p;
 }
 
 std::string CasesDir() { return DYNID_CASES_DIR; }

@@ -5,10 +5,14 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 #include "dynid/mesh/error.hpp"
 #include "dynid/solvers/sparse.hpp"
+
+/// `text` (a std::string or a C string) contains `part`; the text is shown when it does not.
+#define EXPECT_HAS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << "message: " << (text)
 
 namespace dynid::test {
 
@@ -43,6 +47,23 @@ std::string ErrorOf(F&& f) {
 
 /// The whole content of a file (a failed expectation if it cannot be read).
 std::string Slurp(const std::string& path);
+
+/// A fresh, empty folder for the running test's files (<temp>/dynid-<tag>-<pid>-<test name>), removed when the
+/// object goes out of scope.
+class ScratchDir {
+ public:
+  explicit ScratchDir(const std::string& tag);
+  ~ScratchDir();
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  const std::filesystem::path& dir() const { return dir_; }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }  ///< a file in it
+  /// Writes `text` to the file `name` in it; returns its path.
+  std::string write(const std::string& name, const std::string& text) const;
+
+ private:
+  std::filesystem::path dir_;
+};
 
 /// Folder of the repository's bundled cases and of ../shared (set by CMake).
 std::string CasesDir();
