@@ -2,7 +2,6 @@
 // output-only recordings). dynid simulate-test CASE : a virtual test of a case's model, written as UFF 58.
 #include <fmt/core.h>
 
-#include <algorithm>
 #include <filesystem>
 
 #include "commands.hpp"
@@ -194,7 +193,8 @@ struct SimulateArgs {
   bool force = false;
 };
 
-int run_simulate(const SimulateArgs& a, const GlobalOptions& g) {
+/// Writes the recordings (one file per hit location); their paths go to `written_out` if not null.
+int run_simulate(const SimulateArgs& a, const GlobalOptions& g, std::vector<std::string>* written_out = nullptr) {
   set_threads(g.threads);
   const Case c = load_case(a.case_path);
   require_section(c, c.test.has_value(), "test");
@@ -228,6 +228,7 @@ int run_simulate(const SimulateArgs& a, const GlobalOptions& g) {
     for (const std::string& w : written) fmt::print("  wrote {}\n", w);
     fmt::print("  ({} datasets, UFF 58{}); the simulated modes (the truth) in {}\n", datasets, t.binary ? "b" : "", truth);
   }
+  if (written_out) *written_out = written;
   return 0;
 }
 
@@ -237,13 +238,8 @@ int test_step(const std::string& case_path, const std::string& dir, bool force, 
   const Case c = load_case(case_path);
   require_section(c, c.test.has_value(), "test");
   const std::string uff = (fs::path(dir) / "test.uff").string();
-  if (const int rc = run_simulate(SimulateArgs{case_path, uff, force}, g); rc != 0) return rc;
-  IdentifyArgs a;
-  for (const auto& f : fs::directory_iterator(dir)) {  // test.uff, or test-<input>.uff per hit location
-    const std::string name = f.path().filename().string();
-    if (name.rfind("test", 0) == 0 && f.path().extension() == ".uff") a.files.push_back(f.path().string());
-  }
-  std::sort(a.files.begin(), a.files.end());
+  IdentifyArgs a;  // identifies exactly the files simulate-test wrote (test.uff, or test-<input>.uff per hit)
+  if (const int rc = run_simulate(SimulateArgs{case_path, uff, force}, g, &a.files); rc != 0) return rc;
   const IdentificationOptions& io = c.test->identify;
   if (io.band_hi_hz > 0) a.band = {io.band_lo_hz, io.band_hi_hz};
   if (io.max_order > 0) a.orders = {static_cast<double>(io.min_order), static_cast<double>(io.max_order)};

@@ -76,6 +76,10 @@ Eigen::VectorXd subspace_coefficients(const Eigen::VectorXd& a, const Eigen::Mat
   return c;
 }
 
+Eigen::VectorXd subspace_member(const Eigen::VectorXd& a, const Eigen::MatrixXd& B, const std::vector<int>& group) {
+  return group_columns(B, group) * subspace_coefficients(a, B, group);
+}
+
 const ModePair* Pairing::of_a(int a) const {
   for (const ModePair& p : pairs)
     if (p.a == a) return &p;

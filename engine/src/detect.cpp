@@ -94,13 +94,10 @@ Paired pair_with_model(const ModalData& data, const std::vector<int>& rows, cons
     const auto* q = pr.of_a(out.used[k]);
     out.mac[static_cast<Eigen::Index>(k)] = q->mac;
     const std::vector<int>& g = groups[static_cast<std::size_t>(group_of[static_cast<std::size_t>(q->b)])];
-    Eigen::VectorXd v = Pa.col(q->b);
-    if (g.size() > 1) {
-      const Eigen::VectorXd c = subspace_coefficients(data.shapes.col(q->a), Pa, g);
-      v.setZero();
-      for (std::size_t i = 0; i < g.size(); ++i) v += c[static_cast<Eigen::Index>(i)] * Pa.col(g[i]);
-    }
-    out.partner.col(static_cast<Eigen::Index>(k)) = v;
+    if (g.size() > 1)
+      out.partner.col(static_cast<Eigen::Index>(k)) = subspace_member(data.shapes.col(q->a), Pa, g);
+    else
+      out.partner.col(static_cast<Eigen::Index>(k)) = Pa.col(q->b);
   }
   return out;
 }

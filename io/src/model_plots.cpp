@@ -10,14 +10,18 @@ namespace dynid::plot {
 
 namespace {
 
+// The corners of the box holding every node.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> bounds(const Model& model) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (const Node& n : model.nodes()) lo = lo.cwiseMin(n.x), hi = hi.cwiseMax(n.x);
+  return {lo, hi};
+}
+
 // Axis labels and limits that frame the structure with a margin.
 void frame_panel(const Model& model, std::pair<int, int> ax, double margin, Panel* p) {
   static const char* names[] = {"x", "y", "z"};
-  double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
-  for (const Node& n : model.nodes()) {
-    x0 = std::min(x0, n.x[ax.first]), x1 = std::max(x1, n.x[ax.first]);
-    y0 = std::min(y0, n.x[ax.second]), y1 = std::max(y1, n.x[ax.second]);
-  }
+  const auto [lo, hi] = bounds(model);
+  const double x0 = lo[ax.first], x1 = hi[ax.first], y0 = lo[ax.second], y1 = hi[ax.second];
   const double size = std::max({x1 - x0, y1 - y0, 1e-12});
   p->xmin = x0 - margin * size, p->xmax = x1 + margin * size;
   p->ymin = y0 - margin * size, p->ymax = y1 + margin * size;
@@ -69,8 +73,7 @@ Series members(const Model& model, std::pair<int, int> ax, const std::vector<Eig
 }
 
 double structure_size(const Model& model) {
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
-  for (const Node& n : model.nodes()) lo = lo.cwiseMin(n.x), hi = hi.cwiseMax(n.x);
+  const auto [lo, hi] = bounds(model);
   return std::max((hi - lo).maxCoeff(), 1e-12);
 }
 
@@ -83,8 +86,7 @@ std::string hz(double f) {
 }  // namespace
 
 std::pair<int, int> drawing_plane(const Model& model) {
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
-  for (const Node& n : model.nodes()) lo = lo.cwiseMin(n.x), hi = hi.cwiseMax(n.x);
+  const auto [lo, hi] = bounds(model);
   const Eigen::Vector3d ext = hi - lo;
   int a = 0, b = 1;  // the two largest extents, in axis order; a beam along x is drawn in x-y
   if (ext[2] > ext[0] || ext[2] > ext[1]) (ext[0] >= ext[1] ? b : a) = 2;

@@ -48,6 +48,8 @@ Eigen::MatrixXd subspace_mac_matrix(const Eigen::MatrixXd& A, const Eigen::Matri
 /// matches a (the normalised least-squares fit). With mass-normalised modes of a repeated eigenvalue the
 /// combination is again a mass-normalised mode: the member of the subspace the measurement a shows.
 Eigen::VectorXd subspace_coefficients(const Eigen::VectorXd& a, const Eigen::MatrixXd& B, const std::vector<int>& group);
+/// That member itself: sum_k c_k B.col(group[k]) with c = subspace_coefficients(a, B, group).
+Eigen::VectorXd subspace_member(const Eigen::VectorXd& a, const Eigen::MatrixXd& B, const std::vector<int>& group);
 
 /// COMAC per DOF over the paired modes: (sum_k |a_ik b_ik|)^2 / (sum_k a_ik^2 sum_k b_ik^2), shapes scaled to
 /// their MAC-consistent sign. 1 = the DOF agrees in every pair.
