@@ -54,10 +54,7 @@ DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model
   const int sources = !!n["measured"] + !!n["recordings"] + !!n["truth"];
   if (sources != 1) ctx.fail(n, "discover: give exactly one of measured: FILE (modal data), recordings: [FILES] or truth: {model:, test:}");
   if (n["measured"]) d.measured_file = resolve(dir, ctx.string(n["measured"], "discover measured"));
-  if (n["geometry"]) {
-    if (!n["measured"]) ctx.fail(n["geometry"], "discover: geometry ties the measured file to the model; it needs measured:");
-    d.geometry = parse_geometry(n["geometry"], ctx, dir);
-  }
+  d.geometry = parse_geometry(n, "discover", ctx, dir);
   if (n["recordings"]) {
     const YAML::Node& r = n["recordings"];
     if (r.IsScalar()) d.recordings.push_back(resolve(dir, ctx.string(r, "discover recordings")));

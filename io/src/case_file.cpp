@@ -66,8 +66,11 @@ std::vector<MeasuredDof> parse_dof_selection(const YAML::Node& n, const YamlCtx&
   return out;
 }
 
-GeometrySpec parse_geometry(const YAML::Node& n, const YamlCtx& ctx, const std::string& dir) {
+GeometrySpec parse_geometry(const YAML::Node& section, const std::string& name, const YamlCtx& ctx, const std::string& dir) {
   GeometrySpec g;
+  const YAML::Node n = section["geometry"];
+  if (!n) return g;
+  if (!section["measured"]) ctx.fail(n, name + ": geometry ties the measured file to the model; it needs measured:");
   if (n.IsScalar()) {
     g.file = resolve(dir, ctx.string(n, "geometry"));
     return g;
@@ -205,10 +208,7 @@ DetectSpec parse_detect(const YAML::Node& n, const YamlCtx& ctx, const Model& mo
     if (n["measured_dofs"]) ctx.fail(n["measured_dofs"], "detect: measured_dofs is for simulations; measured data carry their own DOFs");
   }
   if (n["reference_measured"]) d.reference_measured_file = resolve(dir, ctx.string(n["reference_measured"], "reference_measured"));
-  if (n["geometry"]) {
-    if (!n["measured"]) ctx.fail(n["geometry"], "detect: geometry ties measured files to the model; it needs measured:");
-    d.geometry = parse_geometry(n["geometry"], ctx, dir);
-  }
+  d.geometry = parse_geometry(n, "detect", ctx, dir);
   if (n["noise"]) parse_noise(n["noise"], ctx, &o);
   if (n["significance"]) o.significance = ctx.number(n["significance"], "significance");
   if (!(o.significance > 0 && o.significance < 1)) ctx.fail(n["significance"], "detect: significance must be in (0, 1)");

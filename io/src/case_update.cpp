@@ -49,10 +49,7 @@ UpdateSpec parse_update(const YAML::Node& n, const YamlCtx& ctx, const Model& mo
   if (n["measured"] && n["target"]) ctx.fail(n, "update: give either measured: (a file) or target: (a simulation), not both");
   if (!n["measured"] && !n["target"]) ctx.fail(n, "update: the measured data are missing: give measured: FILE or target: {...}");
   if (n["measured"]) u.measured_file = resolve(dir, ctx.string(n["measured"], "measured"));
-  if (n["geometry"]) {
-    if (!n["measured"]) ctx.fail(n["geometry"], "update: geometry ties the measured file to the model; it needs measured:");
-    u.geometry = internal::parse_geometry(n["geometry"], ctx, dir);
-  }
+  u.geometry = internal::parse_geometry(n, "update", ctx, dir);
   if (n["target"]) {
     const YAML::Node& t = n["target"];
     ctx.require_map(t, "target");

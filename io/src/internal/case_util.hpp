@@ -15,8 +15,9 @@ std::vector<MeasuredDof> parse_dof_selection(const YAML::Node& n, const YamlCtx&
                                              const std::string& what);
 /// A path relative to the case file's folder (absolute paths unchanged).
 std::string resolve(const std::string& dir, const std::string& file);
-/// geometry: FILE | {file: FILE, match: position | id, tolerance: T} (beside measured:).
-GeometrySpec parse_geometry(const YAML::Node& n, const YamlCtx& ctx, const std::string& dir);
+/// The `geometry:` of a section (`detect`, `update`, `discover`): FILE | {file: FILE, match: position | id,
+/// tolerance: T}, only beside measured:. None given: an empty GeometrySpec.
+GeometrySpec parse_geometry(const YAML::Node& section, const std::string& name, const YamlCtx& ctx, const std::string& dir);
 
 }  // namespace dynid::internal
 
