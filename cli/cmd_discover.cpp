@@ -25,24 +25,33 @@ struct DiscoverArgs {
 void print_summary(const Case& c, const DiscoveryData& d, const DiscoverySummary& s) {
   fmt::print("dynid discover: {} — {} measured modes at {} DOFs ({})\n", c.name, d.measured.num_modes(), d.measured.dofs.size(), d.source);
   for (const std::string& n : d.notes) fmt::print("  note: {}\n", n);
-  fmt::print("  1. where:  {}\n", s.localization.words);
-  fmt::print("  2-3. candidates (BIC improvement over the model as given; > 10 is decisive):\n");
+  for (const std::string& n : set_aside_words(s)) fmt::print("  note: {}\n", n);
+  for (const std::string& w : s.warnings) fmt::print("  warning: {}\n", w);
+  fmt::print("  1. where:  {}\n", localization_words(s));
+  fmt::print("  2-3. candidates (ln Bayes factor over the model as given; > {:.0f} is decisive):\n", c.discover->options.decisive);
   fmt::print("       {:>4}  {:<22} {:<28} {:>9} {:>9} {:>8}\n", "rank", "kind", "where", "evidence", "max df %", "MAC");
   const int show = std::min<int>(12, static_cast<int>(s.candidates.size()));
   for (int k = 0; k < show; ++k) {
     const ScoredHypothesis& h = s.candidates[k];
     std::string where = h.global ? "global" : site_label(h.site, ",");
     if (where.size() > 28) where = where.substr(0, 25) + "...";
-    fmt::print("       {:>4}  {:<22} {:<28} {:>9.1f} {:>9.3f} {:>8.5f}{}\n", k + 1, h.kind, where, h.delta_bic, h.max_freq_error_pct, h.mean_mac,
+    fmt::print("       {:>4}  {:<22} {:<28} {:>9.1f} {:>9.3f} {:>8.5f}{}\n", k + 1, h.kind, where, h.log_evidence, h.max_freq_error_pct, h.mean_mac,
                h.at_bound ? "  (at a bound)" : "");
   }
   const ScoredHypothesis& r = s.recalibration;
-  fmt::print("       {:>4}  {:<22} {:<28} {:>9.1f} {:>9.3f} {:>8.5f}\n", "-", "global_recalibration", "global (E, rho)", r.delta_bic,
+  fmt::print("       {:>4}  {:<22} {:<28} {:>9.1f} {:>9.3f} {:>8.5f}\n", "-", "global_recalibration", "global (E, rho)", r.log_evidence,
              r.max_freq_error_pct, r.mean_mac);
-  fmt::print("  4. verdict: {}\n     {}\n", s.verdict, s.explanation);
+  if (s.steps.size() > 1) {
+    fmt::print("  selection:\n");
+    for (const SelectionStep& st : s.steps)
+      fmt::print("       {:<6} {:<60} ln B {:>8.1f}  explains {:>3.0f} %\n",
+                 st.action == SelectionStep::Action::kStart ? "start" : st.action == SelectionStep::Action::kAdd ? "add" : "remove",
+                 st.description.substr(0, 60), st.log_evidence, 100 * st.explained);
+  }
+  fmt::print("  4. verdict: {}\n     {}\n", to_string(s.verdict), discovery_explanation(s));
   fmt::print("     fit: max frequency error {:.3f} % -> {:.3f} %, mean MAC {:.5f} -> {:.5f}{} ({} eigen-solves, {:.1f} s)\n",
              s.before.max_freq_error_pct, s.after.max_freq_error_pct, s.before.mean_mac, s.after.mean_mac,
-             s.before.unpaired ? fmt::format(", measured modes without a model counterpart {} -> {}", s.before.unpaired, s.after.unpaired) : std::string(),
+             s.before.unpaired || s.after.unpaired ? fmt::format(", measured modes without a partner {} -> {}", s.before.unpaired, s.after.unpaired) : std::string(),
              s.eigen_solves, s.seconds);
 }
 
@@ -93,8 +102,8 @@ int run_discover(const DiscoverArgs& a, const GlobalOptions& g) {
         if (std::isfinite(ck.parameter_error)) worst = std::max(worst, ck.parameter_error);
       }
       named += ok;
-      consistent += sk.verdict == "consistent";
-      runs.push_back({{"seed_offset", k}, {"verdict", sk.verdict}, {"first", sk.findings.empty() ? "" : sk.findings[0].kind}, {"ok", ok}});
+      consistent += sk.verdict == Verdict::kConsistent;
+      runs.push_back({{"seed_offset", k}, {"verdict", to_string(sk.verdict)}, {"first", sk.findings.empty() ? "" : sk.findings[0].kind}, {"ok", ok}});
     };
     record(0, s);
     for (int k = 1; k < seeds; ++k) {

@@ -86,7 +86,8 @@ const ModePair* Pairing::of_a(int a) const {
   return nullptr;
 }
 
-Pairing pair_modes(const Eigen::MatrixXd& mac, const Eigen::VectorXd& fa, const Eigen::VectorXd& fb, double min_mac) {
+Pairing pair_modes(const Eigen::MatrixXd& mac, const Eigen::VectorXd& fa, const Eigen::VectorXd& fb, double min_mac,
+                   double max_ratio) {
   const int na = static_cast<int>(mac.rows()), nb = static_cast<int>(mac.cols());
   const bool freq = fa.size() == na && fb.size() == nb;
   struct Cand {
@@ -97,6 +98,7 @@ Pairing pair_modes(const Eigen::MatrixXd& mac, const Eigen::VectorXd& fa, const 
   for (int i = 0; i < na; ++i)
     for (int j = 0; j < nb; ++j) {
       if (!(mac(i, j) >= min_mac)) continue;
+      if (max_ratio > 0 && freq && fa[i] > 0 && fb[j] > 0 && std::abs(std::log(fb[j] / fa[i])) > std::log(max_ratio)) continue;
       const double df = freq && fa[i] > 0 ? std::min(1.0, std::abs(fb[j] - fa[i]) / fa[i]) : 0.0;
       // A partner more than a factor 2 away in frequency is a spatial alias (few sensors: a high mode can look
       // like a low one at the measured DOFs), never preferred to a nearer one of similar MAC.

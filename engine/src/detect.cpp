@@ -11,6 +11,7 @@
 #include <random>
 #include <sstream>
 
+#include "dynid/engine/residual_force.hpp"
 #include "dynid/engine/sensitivity.hpp"
 #include "dynid/engine/serep.hpp"
 #include "dynid/mesh/error.hpp"
@@ -34,17 +35,6 @@ std::string fmt(double v, int prec = 4) {
   s.precision(prec);
   s << v;
   return s.str();
-}
-
-// Geometric mean of |R(j, :)| over the modes (eq. 8); a zero entry gives 0.
-Eigen::VectorXd pseudo_residual(const Eigen::MatrixXd& R) {
-  Eigen::VectorXd out(R.rows());
-  for (Eigen::Index j = 0; j < R.rows(); ++j) {
-    double s = 0;
-    for (Eigen::Index i = 0; i < R.cols(); ++i) s += std::log(std::abs(R(j, i)));
-    out[j] = R.cols() ? std::exp(s / static_cast<double>(R.cols())) : 0.0;
-  }
-  return out;
 }
 
 struct Paired {
@@ -221,7 +211,7 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
   if (o.candidates.empty()) {
     for (int e = 0; e < model.num_elements(); ++e) {
       const ElementType t = model.elements()[e].type;
-      if (t == ElementType::Beam2D || t == ElementType::Frame2D || t == ElementType::Frame3D || t == ElementType::Matrix)
+      if (is_member(t) || t == ElementType::Matrix)
         cand.push_back(e);
     }
   } else {
@@ -286,10 +276,7 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
                            std::to_string(red.rank) + " of them");
   }
   auto residuals_of = [&](const Eigen::MatrixXd& U, const Eigen::VectorXd& lam) {
-    Eigen::MatrixXd R;
-    if (S.full_dofs) residual_forces(sys.K, sys.M, U, lam, &R);
-    else R = -red.K * U + red.M * U * lam.asDiagonal();
-    return R;
+    return S.full_dofs ? residual_forces(sys.K, sys.M, lam, U) : residual_forces(red.K, red.M, lam, U);
   };
   const Eigen::MatrixXd Uc = scaled_shapes(changed, pc);
   if (S.full_dofs && o.simulated_changed && n <= 3000) {
@@ -298,13 +285,13 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
   } else {
     S.residuals = residuals_of(Uc, lam_c);
   }
-  S.pseudo = pseudo_residual(S.residuals);
+  S.pseudo = pseudo_residual_force(S.residuals);
   S.pseudo_reference = Eigen::VectorXd::Zero(S.pseudo.size());
   if (reference_measured) {
     const Paired pr = pair_with_model(refmeas, rows, ref, o.modes, o.min_mac, "reference-state");
     S.warnings.insert(S.warnings.end(), pr.warnings.begin(), pr.warnings.end());
     if (!pr.used.empty())
-      S.pseudo_reference = pseudo_residual(residuals_of(scaled_shapes(refmeas, pr), lambdas(refmeas, pr.used)));
+      S.pseudo_reference = pseudo_residual_force(residuals_of(scaled_shapes(refmeas, pr), lambdas(refmeas, pr.used)));
   }
   S.delta_pseudo = S.pseudo - S.pseudo_reference;
 

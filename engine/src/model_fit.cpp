@@ -38,6 +38,8 @@ bool FitOptions::IsValid(std::string* why) const {
   if (!(loss_scale > 0)) return fail("loss_scale must be > 0");
   if (max_iterations < 0) return fail("max_iterations must be >= 0");
   if (!(min_mac >= 0 && min_mac <= 1)) return fail("min_mac must be in [0, 1]");
+  if (!(max_frequency_ratio == 0 || max_frequency_ratio > 1)) return fail("max_frequency_ratio must be 0 (no bound) or > 1");
+  if (!(min_visibility >= 0 && min_visibility < 1)) return fail("min_visibility must be in [0, 1)");
   if (extra_modes < 0) return fail("extra_modes must be >= 0");
   return true;
 }
@@ -73,6 +75,9 @@ class Evaluator {
     }
     rows_ = measured_equations(pm.model(), meas.dofs);
     const Model& model = pm.model();
+    for (int n = 0; n < static_cast<int>(model.nodes().size()); ++n)
+      for (int t = 0; t < 3; ++t)
+        if (model.dof_map().eq(n, static_cast<Dof>(t)) >= 0) translations_.push_back(model.dof_map().eq(n, static_cast<Dof>(t)));
     const int n = model.num_dofs();
     bool springs = false;
     for (int p = 0; p < pm.num_parameters(); ++p)  // springs (and custom terms) may tie a free-free model down
@@ -198,8 +203,16 @@ class Evaluator {
       for (Eigen::Index r = 0; r < a; ++r) Pa(r, static_cast<Eigen::Index>(j)) = ev_.ms.Phi(rows_[r], ev_.elastic[j]);
       fe[static_cast<Eigen::Index>(j)] = eigenvalue_to_hz(ev_.ms.lambda[ev_.elastic[j]]);
     }
-    const Eigen::MatrixXd mac = mac_matrix(meas_.shapes, Pa);
-    const Pairing pr = pair_modes(mac, meas_.frequencies_hz, fe, o_.min_mac);
+    Eigen::MatrixXd mac = mac_matrix(meas_.shapes, Pa);
+    // Modes the sensors cannot see are no partners: their MAC with a measurement is noise.
+    if (o_.min_visibility > 0 && !translations_.empty())
+      for (std::size_t j = 0; j < ev_.elastic.size(); ++j) {
+        double all = 0;
+        for (int r : translations_) all += ev_.ms.Phi(r, ev_.elastic[j]) * ev_.ms.Phi(r, ev_.elastic[j]);
+        const double seen = Pa.col(static_cast<Eigen::Index>(j)).squaredNorm() / static_cast<double>(std::max<Eigen::Index>(a, 1));
+        if (seen < o_.min_visibility * all / static_cast<double>(translations_.size())) mac.col(static_cast<Eigen::Index>(j)).setZero();
+      }
+    const Pairing pr = pair_modes(mac, meas_.frequencies_hz, fe, o_.min_mac, o_.max_frequency_ratio);
     const int p = meas_.num_modes();
     ev_.pair.assign(p, -1);
     ev_.forced.assign(p, 0);
@@ -359,6 +372,7 @@ class Evaluator {
   FitOptions o_;
   EigenSolver solver_;
   std::vector<int> rows_;
+  std::vector<int> translations_;  // free translational equations (visibility of model modes)
   bool complete_ = false;
   Eigen::MatrixXd U_;
   Eigen::VectorXd lam_meas_;
@@ -537,6 +551,8 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
   if (!ef.ok) throw NumericalError("fit: the model cannot be evaluated at the solution: " + ef.error);
   out.final_hz = paired_hz(ef);
   out.final_mac = ef.mac;
+  out.final_forced = ef.forced;
+  for (const Eigen::VectorXd& r : ef.r) out.final_chi2_frequency += o.objective == FitObjective::kSerep ? 0.0 : r[0] * r[0];
   if (!out.converged)
     out.warnings.push_back("the fit stopped without converging (Ceres " + out.termination + " after " +
                            std::to_string(out.iterations) + " iterations, cost " + std::to_string(out.initial_cost) +
@@ -565,6 +581,7 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
         J.row(r0 + k).setZero();
         J(r0 + k, k) = std::sqrt(o.regularization) / pm.parameter(free[k]).scale;
       }
+    out.information = J.topRows(rows).transpose() * J.topRows(rows);
     // Full V: its columns beyond the numerical rank span the null space of J (directions the data do not see).
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullV);
     const Eigen::VectorXd& sv = svd.singularValues();
@@ -677,10 +694,9 @@ double FitProblem::cost(const Eigen::VectorXd& theta) {
 
 int FitProblem::evaluations() const { return impl_->ev->evaluations(); }
 
-Correlation correlate(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta, double min_mac) {
-  FitOptions o;
+Correlation correlate(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta, const FitOptions& options) {
+  FitOptions o = options;
   o.objective = FitObjective::kFrequency;
-  o.min_mac = min_mac;
   Evaluator ev(pm, measured, theta, {}, o);
   const Evaluation& e = ev.at(nullptr, false);
   if (!e.ok) throw NumericalError("correlate: " + e.error);

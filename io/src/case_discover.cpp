@@ -49,7 +49,7 @@ DiscoverSpec::Expect parse_expect(const YAML::Node& n, const YamlCtx& ctx, bool 
 DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir) {
   ctx.require_map(n, "discover");
   ctx.only_keys(n, "discover", {"measured", "geometry", "recordings", "identify", "truth", "modes", "min_mpc", "frequency_noise", "shape_noise",
-                                "kinds", "sensor_nodes", "suspension_nodes", "max_effects", "screen", "seeds", "expect", "units"});
+                                "kinds", "sensor_nodes", "suspension_nodes", "max_effects", "screen", "seeds", "expect", "units", "gravity"});
   DiscoverSpec d;
   const int sources = !!n["measured"] + !!n["recordings"] + !!n["truth"];
   if (sources != 1) ctx.fail(n, "discover: give exactly one of measured: FILE (modal data), recordings: [FILES] or truth: {model:, test:}");
@@ -108,7 +108,23 @@ DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model
   if (n["shape_noise"]) o.shape_noise = ctx.number(n["shape_noise"], "discover shape_noise");
   if (n["kinds"]) {
     ctx.require_sequence(n["kinds"], "discover kinds");
-    for (const auto& k : n["kinds"]) o.kinds.push_back(ctx.string(k, "discover kinds"));
+    for (const auto& k : n["kinds"]) {
+      const std::string name = ctx.string(k, "discover kinds");
+      std::string known;
+      bool ok = false;
+      for (const CandidateKind& r : builtin_candidate_kinds()) {
+        ok = ok || r.name == name;
+        known += (known.empty() ? "" : ", ") + r.name;
+      }
+      if (!ok) ctx.fail(k, "discover kinds: unknown candidate kind '" + name + "' (known kinds: " + known + ")");
+      o.kinds.push_back(name);
+    }
+  }
+  if (n["gravity"]) {
+    const std::vector<double> g = ctx.numbers(n["gravity"], "discover gravity");
+    if (g.size() != 3 || Eigen::Vector3d(g[0], g[1], g[2]).norm() == 0)
+      ctx.fail(n["gravity"], "discover gravity: expected a direction [x, y, z] (e.g. [0, -1, 0])");
+    o.gravity = Eigen::Vector3d(g[0], g[1], g[2]);
   }
   if (n["sensor_nodes"]) o.sensor_nodes = ints(n["sensor_nodes"], ctx, "discover sensor_nodes");
   if (n["suspension_nodes"]) o.suspension_nodes = ints(n["suspension_nodes"], ctx, "discover suspension_nodes");
@@ -160,6 +176,7 @@ ModalData keep_modes(ModalData m, const DiscoverSpec& d, std::vector<std::string
   pick(m.mpc, &o.mpc);
   pick(m.frequency_std_hz, &o.frequency_std_hz);
   pick(m.damping_std, &o.damping_std);
+  pick(m.shape_std, &o.shape_std);
   return o;
 }
 }  // namespace

@@ -5,6 +5,7 @@
 #include <set>
 
 #include "dynid/io/modal_data_io.hpp"
+#include "internal/text_util.hpp"
 
 namespace dynid {
 
@@ -55,7 +56,8 @@ std::string short_kind(const std::string& k) {
       {"semi_rigid_joint", "joint"},       {"flexible_support", "support"},  {"lumped_mass", "mass"},
       {"element_stiffness", "EI"},         {"element_mass", "m"},            {"grounded_spring", "spring"},
       {"rotational_spring", "rot.spring"}, {"shear_deformation", "shear"},   {"axial_preload", "preload"},
-      {"distributed_mass", "dist.mass"},   {"sensor_mass", "sensors"},       {"suspension_stiffness", "suspension"}};
+      {"distributed_mass", "dist.mass"},   {"sensor_mass", "sensors"},       {"suspension_stiffness", "suspension"},
+      {"element_point_mass", "mass on el."}, {"member_damage", "EI run"},   {"self_weight", "weight"}};
   for (const auto& [a, b] : names)
     if (k == a) return b;
   return k;
@@ -99,16 +101,127 @@ std::string site_label(const Site& s, const std::string& sep) {
   return w;
 }
 
+namespace {
+
+using internal::format_number;
+
+std::string pct(double share) { return std::to_string(static_cast<int>(std::lround(100.0 * share))); }
+
+std::string noise_words(const DiscoverySummary& s) {
+  auto src = [](NoiseModel::Source x) {
+    return x == NoiseModel::Source::kStated ? "stated" : x == NoiseModel::Source::kData ? "from the data" : "assumed";
+  };
+  return "noise " + format_number(100 * s.noise.frequency, 3) + " % in frequency (" + src(s.noise.frequency_source) + "), " +
+         format_number(100 * s.noise.shape, 3) + " % in shape (" + src(s.noise.shape_source) + ")";
+}
+
+std::string fit_words(const DiscoverySummary& s) {
+  return "max frequency error " + format_number(s.before.max_freq_error_pct, 3) + " % -> " + format_number(s.after.max_freq_error_pct, 3) +
+         " %, mean MAC " + format_number(s.before.mean_mac, 4) + " -> " + format_number(s.after.mean_mac, 4);
+}
+
+std::string findings_words(const DiscoverySummary& s) {
+  std::string w;
+  for (std::size_t k = 0; k < s.findings.size(); ++k) w += (k ? "; and " : "") + s.findings[k].finding;
+  return w;
+}
+
+std::string misfit_words(const DiscoverySummary& s) {
+  return "chi-square per datum: frequencies " + format_number(s.chi2_frequency_before, 3) + ", shapes " +
+         format_number(s.chi2_shape_before, 3) + " at the " + noise_words(s) + "; max frequency error " +
+         format_number(s.before.max_freq_error_pct, 3) + " %, mean MAC " + format_number(s.before.mean_mac, 4);
+}
+
+}  // namespace
+
+std::string discovery_explanation(const DiscoverySummary& s) {
+  switch (s.reason) {
+    case VerdictReason::kWithinNoise:
+      return "No missing physics: the model fits the data within the noise (" + misfit_words(s) + ").";
+    case VerdictReason::kNothingDecisive: {
+      std::string best = "none fitted";
+      for (const ScoredHypothesis& h : s.candidates)
+        if (h.fitted) {
+          best = h.description + ", ln Bayes factor " + format_number(h.log_evidence, 3);
+          break;
+        }
+      return "The model misfits the data (" + misfit_words(s) + "), but no candidate explains it decisively and without "
+             "worsening the fit of any mode (best: " + best + "). An effect outside the library, or several at once, is "
+             "possible; more modes or more measured DOFs would constrain the candidates.";
+    }
+    case VerdictReason::kPartlyExplained:
+      return "The model misses something the candidates describe only in part: the best explanation, " + findings_words(s) +
+             ", removes " + pct(s.explained) + " % of the misfit beyond the noise (" + fit_words(s) +
+             "). An effect outside the library, or several at once, is likely.";
+    case VerdictReason::kRivals: {
+      std::string r;
+      for (std::size_t k = 0; k < s.rivals.size(); ++k)
+        r += (k ? "; " : "") + s.rivals[k].description + " (ln Bayes factor " + format_number(s.rivals[k].log_evidence, 3) + ")";
+      return "The model misses something, but the data cannot tell which: the best explanation, " + findings_words(s) +
+             " (ln Bayes factor " + format_number(s.combined.log_evidence, 3) + "; " + fit_words(s) + "), fits about as well as " + r +
+             ". More modes, or sensors at the competing sites (rotations or strains there), would decide.";
+    }
+    case VerdictReason::kExplained: {
+      std::string w = "Missing physics: " + findings_words(s) + ". " + fit_words(s) + "; the findings remove " + pct(s.explained) +
+                      " % of the misfit beyond the noise, decisively (ln Bayes factor " + format_number(s.combined.log_evidence, 3) +
+                      " over the model as given";
+      if (s.recalibration.fitted) w += ", " + format_number(s.recalibration.log_evidence, 3) + " for recalibrating E and rho globally";
+      return w + ").";
+    }
+  }
+  return "";
+}
+
+std::string localization_words(const DiscoverySummary& s) {
+  const Localization& L = s.localization;
+  std::string w;
+  if (s.reason == VerdictReason::kWithinNoise) w = "The model fits within the noise, so what follows describes noise, not a mismatch. ";
+  if (L.nodes.size() < 3) {
+    w += "Only " + std::to_string(L.nodes.size()) + " measured node" + (L.nodes.size() == 1 ? "" : "s") +
+         ": the residual forces cannot say where. ";
+  } else {
+    std::string where;
+    for (std::size_t k = 0; k < L.nodes.size() && k < 3; ++k)
+      where += (k ? ", " : "") + std::to_string(L.nodes[k].node) + " (" + pct(L.nodes[k].share) + " %)";
+    const Eigen::Vector3d& ds = L.direction_share;
+    const char* dir = ds[0] >= ds[1] && ds[0] >= ds[2] ? "x" : ds[1] >= ds[2] ? "y" : "z";
+    w += std::string("The residual forces are ") + (L.localized ? "localized" : "spread over the structure") + ": largest at nodes " +
+         where + "; " + pct(L.concentration) + " % in the top fifth of the measured nodes, mostly in " + dir + ". ";
+  }
+  w += std::string("The model is ") + (L.mean_frequency_error_pct > 0 ? "stiffer" : "softer") +
+       " than the data on average (mean frequency error " + format_number(L.mean_frequency_error_pct, 3) + " %); the mismatch is " +
+       to_string(L.nature) + "-like (residual alignment with inertia forces " + format_number(L.mass_alignment, 2) + ").";
+  return w;
+}
+
+std::vector<std::string> set_aside_words(const DiscoverySummary& s) {
+  std::vector<std::string> out;
+  for (const SetAside& a : s.set_aside) {
+    std::string w = "measured mode " + std::to_string(a.mode + 1) + " (" + format_number(a.frequency_hz, 4) + " Hz) ";
+    if (a.reason == SetAside::Reason::kRigidBody) {
+      w += "is a rigid-body motion on the test's suspension (MAC " + format_number(a.mac, 3) +
+           " with the model's rigid-body motions, below its first elastic mode): set aside; suspension_stiffness describes it";
+    } else {
+      w += "has no plausible partner in the model as given (best MAC " + format_number(a.mac, 3) + "): set aside, never forced onto another mode";
+      if (a.paired_after)
+        w += "; with the findings the model predicts it at " + format_number(a.model_hz_after, 4) + " Hz (MAC " + format_number(a.mac_after, 3) + ")";
+    }
+    out.push_back(w);
+  }
+  return out;
+}
+
 ExpectCheck check_expectation(const DiscoverSpec::Expect& e, const DiscoverySummary& s) {
   ExpectCheck c;
-  c.verdict = s.verdict == e.verdict;
+  const std::string verdict = to_string(s.verdict);
+  c.verdict = verdict == e.verdict;
   if (e.verdict != "missing_physics") {
     c.kind = c.location = true;
-    c.words = c.verdict ? "verdict '" + s.verdict + "' as expected" : "verdict '" + s.verdict + "', expected '" + e.verdict + "'";
+    c.words = c.verdict ? "verdict '" + verdict + "' as expected" : "verdict '" + verdict + "', expected '" + e.verdict + "'";
     return c;
   }
   if (s.findings.empty()) {
-    c.words = "no finding (verdict '" + s.verdict + "'), expected " + e.kind;
+    c.words = "no finding (verdict '" + verdict + "'), expected " + e.kind;
     return c;
   }
   // With several expected effects, the first finding must be one of them (any) and each of the others must be
@@ -144,14 +257,17 @@ ExpectCheck check_expectation(const DiscoverSpec::Expect& e, const DiscoverySumm
 }
 
 nlohmann::ordered_json discovery_json(const Case& c, const DiscoveryData& d, const DiscoverySummary& s, const ExpectCheck* check) {
+  auto or_null = [](bool ok, double v) { return ok && std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr); };
   nlohmann::ordered_json j;
   j["case"] = c.name;
-  j["verdict"] = s.verdict;
-  j["explanation"] = s.explanation;
+  j["verdict"] = to_string(s.verdict);
+  j["reason"] = to_string(s.reason);
+  j["explanation"] = discovery_explanation(s);
   j["findings"] = nlohmann::ordered_json::array();
   for (const ScoredHypothesis& h : s.findings) {
     nlohmann::ordered_json f;
     f["kind"] = h.kind;
+    f["nature"] = to_string(h.nature);
     f["location"] = location_json(h);
     f["parameters"] = values_json(h.values, false);
     f["std"] = values_json(h.values, true);
@@ -159,17 +275,34 @@ nlohmann::ordered_json discovery_json(const Case& c, const DiscoveryData& d, con
     for (const PhysicalValue& v : h.values) units[v.name] = v.unit;
     f["units"] = units;
     f["description"] = h.finding;
+    f["importance"] = or_null(true, h.log_evidence);
+    f["significance"] = h.significance;
     f["at_bound"] = h.at_bound;
     j["findings"].push_back(f);
   }
+  j["combined"] = {{"kinds", s.combined.kind},
+                   {"log_evidence", or_null(!s.findings.empty(), s.combined.log_evidence)},
+                   {"explained", s.explained},
+                   {"parameters", s.combined.parameters}};
+  j["steps"] = nlohmann::ordered_json::array();
+  for (const SelectionStep& st : s.steps) {
+    const char* a = st.action == SelectionStep::Action::kStart ? "start" : st.action == SelectionStep::Action::kAdd ? "add" : "remove";
+    j["steps"].push_back({{"action", a}, {"effect", st.description}, {"log_evidence", or_null(true, st.log_evidence)},
+                          {"explained", st.explained}, {"max_freq_error_pct", st.max_freq_error_pct}, {"mean_mac", st.mean_mac}});
+  }
+  j["rivals"] = nlohmann::ordered_json::array();
+  for (const ScoredHypothesis& h : s.rivals)
+    j["rivals"].push_back({{"kinds", h.kind}, {"description", h.description}, {"log_evidence", or_null(true, h.log_evidence)},
+                           {"max_freq_error_pct", h.max_freq_error_pct}, {"mean_mac", h.mean_mac}});
   j["candidates"] = nlohmann::ordered_json::array();
   for (const ScoredHypothesis& h : s.candidates) {
     nlohmann::ordered_json q;
     q["kind"] = h.kind;
     q["location"] = location_json(h);
     q["description"] = h.description;
-    q["score"] = h.fitted ? nlohmann::ordered_json(h.delta_bic) : nlohmann::ordered_json(nullptr);
-    q["bic"] = h.fitted ? nlohmann::ordered_json(h.bic) : nlohmann::ordered_json(nullptr);
+    q["score"] = or_null(h.fitted, h.log_evidence);
+    q["explained"] = h.explained;
+    q["significance"] = h.significance;
     q["screening"] = h.screening;
     q["parameters"] = values_json(h.values, false);
     q["max_freq_error_pct"] = h.max_freq_error_pct;
@@ -179,7 +312,7 @@ nlohmann::ordered_json discovery_json(const Case& c, const DiscoveryData& d, con
   }
   {
     const ScoredHypothesis& r = s.recalibration;
-    j["recalibration"] = {{"score", r.fitted ? nlohmann::ordered_json(r.delta_bic) : nlohmann::ordered_json(nullptr)},
+    j["recalibration"] = {{"score", or_null(r.fitted, r.log_evidence)},
                           {"parameters", values_json(r.values, false)},
                           {"max_freq_error_pct", r.max_freq_error_pct},
                           {"mean_mac", r.mean_mac}};
@@ -187,34 +320,45 @@ nlohmann::ordered_json discovery_json(const Case& c, const DiscoveryData& d, con
   j["fit"] = {{"before", quality_json(s.before)}, {"after", quality_json(s.after)}};
   const Localization& L = s.localization;
   nlohmann::ordered_json loc;
-  loc["words"] = L.words;
+  loc["words"] = localization_words(s);
   loc["localized"] = L.localized;
   loc["concentration"] = L.concentration;
-  loc["nature"] = L.nature;
+  loc["nature"] = to_string(L.nature);
   loc["mass_alignment"] = L.mass_alignment;
   loc["mean_frequency_error_pct"] = L.mean_frequency_error_pct;
   loc["direction_share"] = {L.direction_share[0], L.direction_share[1], L.direction_share[2]};
   loc["nodes"] = nlohmann::ordered_json::array();
   for (const auto& n : L.nodes) loc["nodes"].push_back({{"node", n.node}, {"share", n.share}, {"x", n.x}, {"y", n.y}, {"z", n.z}});
   j["localization"] = loc;
+  auto source = [](NoiseModel::Source x) { return x == NoiseModel::Source::kStated ? "stated" : x == NoiseModel::Source::kData ? "data" : "default"; };
+  j["noise"] = {{"frequency", s.noise.frequency}, {"frequency_source", source(s.noise.frequency_source)},
+                {"shape", s.noise.shape}, {"shape_source", source(s.noise.shape_source)}, {"scale", s.noise_scale}};
+  j["set_aside"] = nlohmann::ordered_json::array();
+  for (const SetAside& a : s.set_aside)
+    j["set_aside"].push_back({{"mode", a.mode + 1}, {"frequency_hz", a.frequency_hz},
+                              {"reason", a.reason == SetAside::Reason::kRigidBody ? "rigid_body" : "no_partner"}, {"mac", a.mac},
+                              {"paired_after", a.paired_after}, {"model_hz_after", a.model_hz_after}, {"mac_after", a.mac_after}});
   j["data"] = {{"source", d.source},
                {"identified", d.identified},
                {"modes", s.before.measured_hz.size()},
                {"dofs", d.measured.dofs.size()},
                {"residuals", s.data},
-               {"chi2_per_datum_before", s.chi2_per_datum_before},
+               {"chi2_frequency_before", s.chi2_frequency_before},
+               {"chi2_shape_before", s.chi2_shape_before},
                {"notes", d.notes}};
   j["measured"] = modal_data_json(d.measured);
   j["cost"] = {{"seconds", s.seconds}, {"eigen_solves", s.eigen_solves}};
   if (check) j["check"] = {{"ok", check->ok()}, {"words", check->words}, {"parameter_error", check->parameter_error}};
-  j["warnings"] = s.warnings;
+  std::vector<std::string> warnings = s.warnings;
+  for (const std::string& w : set_aside_words(s)) warnings.push_back(w);
+  j["warnings"] = warnings;
   return j;
 }
 
 plot::Figure discovery_figure(const Case& c, const DiscoverySummary& s) {
   const Model& m = c.model;
   plot::Figure f;
-  f.title = "dynid discover: " + c.name + " - " + s.verdict;
+  f.title = std::string("dynid discover: ") + c.name + " - " + to_string(s.verdict);
   f.rows = 2;
   f.cols = 2;
   f.width = 1600;
@@ -287,10 +431,10 @@ plot::Figure discovery_figure(const Case& c, const DiscoverySummary& s) {
   }
   if (!site.x.empty()) map.series.push_back(site);
 
-  // (2) candidates ranked by evidence (BIC improvement over the model as given).
+  // (2) candidates ranked by evidence (ln Bayes factor over the model as given).
   plot::Panel rank;
-  rank.title = "Why: candidates by evidence (BIC gain)";
-  rank.ylabel = "BIC improvement";
+  rank.title = "Why: candidates by evidence (ln Bayes factor)";
+  rank.ylabel = "ln Bayes factor over the model as given";
   plot::Series good, rest, recal;
   good.kind = rest.kind = recal.kind = plot::Kind::kBars;
   good.color = 3;
@@ -302,20 +446,22 @@ plot::Figure discovery_figure(const Case& c, const DiscoverySummary& s) {
   double lo = 0;
   for (int k = 0; k < show; ++k) {
     const ScoredHypothesis& h = s.candidates[k];
-    const bool found = !s.findings.empty() && h.description == s.findings[0].description;
+    bool found = false;
+    for (const ScoredHypothesis& g : s.findings) found = found || h.description == g.description;
     plot::Series& t = found ? good : rest;
+    const double y = h.fitted && std::isfinite(h.log_evidence) ? h.log_evidence : 0.0;
     t.x.push_back(k + 1);
-    t.y.push_back(h.fitted ? h.delta_bic : 0.0);
-    lo = std::min(lo, h.fitted ? h.delta_bic : 0.0);
+    t.y.push_back(y);
+    lo = std::min(lo, y);
     const std::string lab = short_kind(h.kind) + " " +
                             (h.global ? "[" + std::to_string(h.site.elements.size()) + " el]" : site_label(h.site, " "));
     rank.xticks.push_back({static_cast<double>(k + 1), lab});
   }
   recal.x.push_back(show + 1);
-  recal.y.push_back(s.recalibration.fitted ? s.recalibration.delta_bic : 0.0);
+  recal.y.push_back(s.recalibration.fitted && std::isfinite(s.recalibration.log_evidence) ? s.recalibration.log_evidence : 0.0);
   rank.xticks.push_back({static_cast<double>(show + 1), "E, rho"});
   rank.series = {rest, good, recal};
-  rank.hlines = {{10.0, "decisive"}};
+  rank.hlines = {{c.discover ? c.discover->options.decisive : 5.0, "decisive"}};
   rank.ymin = std::min(lo, 0.0);
 
   // (3) frequency errors and (4) MAC, before and after.
@@ -337,14 +483,14 @@ plot::Figure discovery_figure(const Case& c, const DiscoverySummary& s) {
   fa.color = ma.color = 3;
   mb.kind = ma.kind = plot::Kind::kLineMarkers;
   plot::Series lost;
-  lost.label = "x  no model counterpart (MAC < 0.5)";
+  lost.label = "x  no plausible model partner";
   lost.kind = plot::Kind::kMarkers;
   lost.symbol = 5;
   lost.symbol_scale = 2.0;
   lost.color = 0;
   for (Eigen::Index k = 0; k < s.before.measured_hz.size(); ++k) {
     const double x = static_cast<double>(k + 1);
-    if (s.before.mac[k] >= 0.5) {
+    if (s.before.paired.empty() || s.before.paired[static_cast<std::size_t>(k)]) {
       fb.x.push_back(x);
       fb.y.push_back(100 * (s.before.model_hz[k] - s.before.measured_hz[k]) / s.before.measured_hz[k]);
     } else {

@@ -44,11 +44,7 @@ bool parse_dof_field(std::string_view f, Dof* d) {
   return parse_dof(f, d);
 }
 
-std::string fmt(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3g", v);
-  return b;
-}
+std::string fmt(double v) { return internal::format_number(v, 3); }
 
 }  // namespace
 

@@ -47,7 +47,7 @@ Series members(const Model& model, std::pair<int, int> ax, const std::vector<Eig
     if (el.num_nodes != 2) continue;
     const int a = model.element_nodes(e)[0], b = model.element_nodes(e)[1];
     const Eigen::Vector3d xa = model.nodes()[a].x, xb = model.nodes()[b].x;
-    const bool member = el.type == ElementType::Beam2D || el.type == ElementType::Frame2D || el.type == ElementType::Frame3D;
+    const bool member = is_member(el.type);
     if (u.empty() || !member) {
       add(u.empty() ? xa : Eigen::Vector3d(xa + scale * u[a]));
       add(u.empty() ? xb : Eigen::Vector3d(xb + scale * u[b]));

@@ -7,15 +7,12 @@
 
 #include "dynid/io/modal_data_io.hpp"
 #include "dynid/mesh/error.hpp"
+#include "internal/text_util.hpp"
 
 namespace dynid {
 
 namespace {
-std::string fmt(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
-}
+std::string fmt(double v) { return internal::format_number(v, 4); }
 std::string point(const Eigen::Vector3d& x) { return "(" + fmt(x.x()) + ", " + fmt(x.y()) + ", " + fmt(x.z()) + ")"; }
 }  // namespace
 

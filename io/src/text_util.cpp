@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstdio>
 #include <cctype>
 #include <climits>
 #include <filesystem>
@@ -72,6 +73,12 @@ bool parse_double(std::string_view s, double* out) {
   if (n == 0) return false;
   const auto r = std::from_chars(buf, buf + n, *out);
   return r.ec == std::errc() && r.ptr == buf + n;
+}
+
+std::string format_number(double v, int digits) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.*g", digits, v);
+  return b;
 }
 
 bool parse_int(std::string_view s, int* out) {

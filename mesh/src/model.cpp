@@ -251,9 +251,7 @@ void Model::finalize() {
     }
     for (double f : {e.factors.E, e.factors.rho, e.factors.A, e.factors.I})
       if (!finite_positive(f)) throw InputError(who + ": property factors must be finite and > 0");
-    const bool member = e.type == ElementType::Beam2D || e.type == ElementType::Frame2D ||
-                        e.type == ElementType::Frame3D;
-    if (member) {
+    if (is_member(e.type)) {
       if (e.num_nodes != 2) throw InputError(who + ": needs 2 nodes");
       const Eigen::Vector3d& a = nodes_[element_nodes_[k][0]].x;
       const Eigen::Vector3d& b = nodes_[element_nodes_[k][1]].x;
@@ -562,6 +560,55 @@ Eigen::MatrixXd Model::unit_geometric_stiffness(int e) const {
   const double unit = 1.0;
   member_local(e, &loc, &T, &unit);
   return T.transpose() * loc.Kg * T;
+}
+
+Eigen::MatrixXd Model::member_point_interpolation(int e, double xi, Eigen::MatrixXd* dN) const {
+  require_finalized("member_point_interpolation");
+  const ElementType t = elements_[e].type;
+  if (t != ElementType::Beam2D && t != ElementType::Frame2D && t != ElementType::Frame3D)
+    throw InputError("element " + std::to_string(elements_[e].id) + ": only beams and frames have a member axis");
+  internal::MemberLocal loc;
+  Eigen::MatrixXd T;  // local DOFs from the element's global DOFs
+  member_local(e, &loc, &T);
+  const double L = (nodes_[element_nodes_[e][1]].x - nodes_[element_nodes_[e][0]].x).norm();
+  // Hermite functions for (w1, L t1, w2, L t2) and the linear ones for (u1, u2), with their xi-derivatives.
+  const double x2 = xi * xi, x3 = x2 * xi;
+  const Eigen::Vector4d H(1 - 3 * x2 + 2 * x3, L * (xi - 2 * x2 + x3), 3 * x2 - 2 * x3, L * (-x2 + x3));
+  const Eigen::Vector4d dH(-6 * xi + 6 * x2, L * (1 - 4 * xi + 3 * x2), 6 * xi - 6 * x2, L * (-2 * xi + 3 * x2));
+  const bool three = t == ElementType::Frame3D;
+  const int nl = three ? 12 : 6, per = nl / 2;
+  Eigen::MatrixXd Nl = Eigen::MatrixXd::Zero(3, nl), dNl = Eigen::MatrixXd::Zero(3, nl);  // local translations
+  Nl(0, 0) = 1 - xi, Nl(0, per) = xi, dNl(0, 0) = -1, dNl(0, per) = 1;
+  // Local v from (v, t_z) at both ends (v' = +t_z); 3D local w from (w, t_y) with w' = -t_y.
+  const std::array<int, 4> xy = three ? std::array<int, 4>{{1, 5, 7, 11}} : std::array<int, 4>{{1, 2, 4, 5}};
+  for (int k = 0; k < 4; ++k) Nl(1, xy[k]) = H[k], dNl(1, xy[k]) = dH[k];
+  if (three) {
+    const std::array<int, 4> xz{{2, 4, 8, 10}};
+    const Eigen::Vector4d s(1, -1, 1, -1);
+    for (int k = 0; k < 4; ++k) Nl(2, xz[k]) = s[k] * H[k], dNl(2, xz[k]) = s[k] * dH[k];
+  }
+  // Local translation axes in global coordinates: the rows of T's first 3x3 block (Beam2D: T maps (uy, rz)).
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  if (three) {
+    internal::frame3d_axes(nodes_[element_nodes_[e][0]].x, nodes_[element_nodes_[e][1]].x, elements_[e].orientation, &R);
+  } else {
+    const Eigen::Vector3d d = (nodes_[element_nodes_[e][1]].x - nodes_[element_nodes_[e][0]].x) / L;
+    R << d.x(), d.y(), 0, -d.y(), d.x(), 0, 0, 0, 1;
+  }
+  if (dN) *dN = R.transpose() * dNl * T;
+  return R.transpose() * Nl * T;
+}
+
+double Model::member_axial_force(int e, const Eigen::VectorXd& u) const {
+  require_finalized("member_axial_force");
+  const ElementType t = elements_[e].type;
+  if (t != ElementType::Frame2D && t != ElementType::Frame3D) return 0.0;  // Beam2D: no axial DOFs
+  internal::MemberLocal loc;
+  Eigen::MatrixXd T;
+  member_local(e, &loc, &T);
+  const Eigen::VectorXd ul = T * u;
+  const int per = static_cast<int>(ul.size()) / 2;
+  return loc.Ka(per, per) * (ul[per] - ul[0]);
 }
 
 void Model::element_matrices(int e, Eigen::MatrixXd* K, Eigen::MatrixXd* M) const {

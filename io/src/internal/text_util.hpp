@@ -23,6 +23,9 @@ bool parse_double(std::string_view s, double* out);
 /// An integer (the whole field, blanks ignored), within int range.
 bool parse_int(std::string_view s, int* out);
 
+/// A number for messages and reports, `digits` significant digits ("%.*g": 0.0123, 1.5e+07).
+std::string format_number(double v, int digits = 4);
+
 /// The numbers of a Fortran record: split on blanks first; if a field is not a number (fields run together,
 /// e.g. "-1.23456E+100-2.34567E+100"), by the fixed column `widths` of the record's format instead, repeated
 /// cyclically to the end of the line (blank fixed fields are skipped); if that fails too (narrower fields than

@@ -28,9 +28,10 @@ struct Pairing {
 /// One-to-one pairing by MAC: repeatedly takes the pair with the highest score MAC - 0.1 min(1, |f_b - f_a|/f_a)
 /// (MAC decides; the frequency breaks near-ties such as the twin modes of symmetric structures), less min(0.9, 0.2 |ln(f_b/f_a)|)
 /// for partners more than a factor 2 apart in frequency (spatial aliases at few sensors), among pairs with
-/// MAC >= min_mac. fa, fb may be empty (no frequency tie-break).
+/// MAC >= min_mac. fa, fb may be empty (no frequency tie-break). With max_ratio > 0, partners further apart in
+/// frequency than that factor are not plausible and never paired (the mode is left unpaired).
 Pairing pair_modes(const Eigen::MatrixXd& mac, const Eigen::VectorXd& fa, const Eigen::VectorXd& fb,
-                   double min_mac = 0.5);
+                   double min_mac = 0.5, double max_ratio = 0);
 
 /// Repeated eigenvalues (symmetric structures: the two bending modes of a square tower): groups of the columns
 /// of B whose frequencies fb lie within rel_tol (relative) of their neighbour's, in order; a single mode is a

@@ -1,96 +1,76 @@
 // dynid/engine/discovery.hpp -- missing-physics discovery: where a model and measured modes disagree, which
 // physics the model left out, its fitted parameters, and the fit before and after.
 //
-// Four steps (docs/method.md, "Discovery"):
-//  1. Locate: residual forces of the measured modes on the model reduced by SEREP to the measured DOFs, summarised
-//     per node and direction (localized or spread; stiffness-like or mass-like), and a linearised screening of
-//     every local hypothesis (one eigen-solve for all of them).
-//  2. Hypothesize: a library of candidate augmentations (class Candidate: a small parametric dK(theta), dM(theta)
-//     with bounds and a physical meaning), placed at the screened sites or applied globally.
-//  3. Fit and select: every plausible candidate fitted with Ceres (fit_parameters), scored by BIC on the whitened
-//     frequency and shape residuals; further effects added greedily while the score improves decisively; the
-//     classic alternative (recalibrate E and rho globally) is scored too.
-//  4. Report: the verdict, the findings with uncertainties, the ranking, and the fit before and after.
+// discover() is a short driver over named stages (docs/method.md, "Discovery"):
+//  1. prepare:  the noise model (stated, carried by the data, or a conservative default with a warning) and the
+//               measured modes set aside (rigid-body modes of a free-free test on its suspension);
+//  2. locate:   residual forces (eq. 6-8, residual_force.hpp) of the measured modes on the model reduced by SEREP to
+//               the measured DOFs, summarised per node and direction;
+//  3. screen:   one linearisation of the whitened frequency and shape residuals ranks every local candidate;
+//  4. fit:      the screened candidates, every global one and the recalibration of E and rho fitted (Ceres), each
+//               scored by its Laplace-approximated evidence with physical priors;
+//  5. select:   effects added while each is decisive, explains a real share of the misfit left and keeps every
+//               mode's fit (no finding may worsen the largest frequency error or the mean MAC); after every
+//               addition each chosen effect must still earn its place (backward elimination);
+//  6. decide:   the verdict and why, as data (the words are io's: discover_io.hpp).
 // The engine reads no files and prints nothing.
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "dynid/engine/candidate.hpp"
 #include "dynid/engine/modal_data.hpp"
-#include "dynid/engine/model_fit.hpp"
-#include "dynid/engine/parametric.hpp"
 #include "dynid/mesh/model.hpp"
 
 namespace dynid {
 
-/// Where a candidate acts (user ids).
-struct Site {
-  std::vector<int> nodes, elements;
-};
-
-/// One parameter of a candidate, in the candidate's own dimensionless units (well scaled for the optimiser).
-struct CandidateParameter {
-  std::string name;
-  double nominal = 0, lower = 0, upper = 1;
-};
-
-/// A parameter in physical units (what the report states).
-struct PhysicalValue {
-  std::string name, unit;
-  double value = 0, std = 0;
-};
-
-/// A model augmentation hypothesis. A new kind of missing physics is one small class: its parameters with bounds,
-/// its dK(theta), dM(theta) and their derivatives (as CustomTerms on the model), and its physical meaning.
-class Candidate {
- public:
-  virtual ~Candidate() = default;
-  virtual std::string kind() const = 0;           ///< "semi_rigid_joint", "lumped_mass", ...
-  virtual std::string description() const = 0;    ///< one line: "rotational spring between element 12 and node 5"
-  virtual Site site() const = 0;
-  virtual bool global() const { return false; }   ///< acts on the whole structure (or a group)
-  virtual std::vector<CandidateParameter> parameters() const = 0;
-  /// dK, dM as custom terms on `model`, on this candidate's parameters numbered from `first` in the
-  /// ParametricModel (the caller adds the parameters, then these terms).
-  virtual std::vector<CustomTerm> terms(const Model& model, int first) const = 0;
-  /// The fitted parameters in physical units (theta, std: this candidate's, dimensionless).
-  virtual std::vector<PhysicalValue> physical(const Eigen::VectorXd& theta, const Eigen::VectorXd& std) const = 0;
-  /// What was left out, in words, with the values ("the base at node 1 is not fixed: rotational spring ...").
-  virtual std::string finding(const std::vector<PhysicalValue>& values) const = 0;
-};
-
 struct DiscoveryOptions {
-  FitOptions fit;                  ///< objective (combined), noise levels, pairing; see FitOptions
-  /// Noise levels used to whiten the residuals: measured frequencies (relative std) and shape entries (std
-  /// relative to each mode's largest entry). Identified data give their own frequency spread; these are floors.
-  double frequency_noise = 1e-3, shape_noise = 5e-2;
+  /// Noise of the measured data: relative std of the frequencies, and std of shape entries relative to each mode's
+  /// largest entry. NaN = not stated: the data's own estimates (ModalData::frequency_std_hz, shape_std) where it
+  /// carries them, else the conservative defaults below, with a warning (a silent optimistic default would call
+  /// every mismatch of noisy data missing physics).
+  double frequency_noise = std::numeric_limits<double>::quiet_NaN();
+  double shape_noise = std::numeric_limits<double>::quiet_NaN();
+  double default_frequency_noise = 0.01, default_shape_noise = 0.05;
+  /// The model is consistent with the data when the chi-square of its whitened residuals stays below the quantile
+  /// 1 - consistency_level of the chi-square distribution (frequencies and shapes tested separately, each at
+  /// half this level).
+  double consistency_level = 1e-3;
   int screen_fit = 16;             ///< local candidates fitted in full after the linear screening
-  int max_effects = 3;             ///< greedy: at most this many effects combined (and at most one fitted
-                                   ///< parameter per two measured modes)
-  /// Decisive evidence (BIC difference; 10 = "very strong" on the Kass-Raftery scale) for a finding and for each
-  /// further effect; an alternative within `ambiguity` of the best makes the verdict inconclusive.
-  double decisive = 10.0, ambiguity = 6.0;
-  /// The nominal model must misfit the data by more than this before any finding is made (chi-square per datum,
-  /// whitened by the noise levels above, of the frequencies or of the shape entries, whichever is larger; the
-  /// few frequencies are not diluted by the many shape entries): below it the model is consistent with the data.
-  double min_misfit = 2.0;
-  /// A further effect's parameters must differ from nominal by this many standard deviations (a posteriori).
+  int max_effects = 3;             ///< at most this many effects combined (and one parameter per two measured modes)
+  /// Evidence thresholds, natural log of the Bayes factor: `decisive` for a finding and for each further effect
+  /// (5 = 150:1, "very strong" on the Kass-Raftery scale); a different explanation within `ambiguity` of the
+  /// findings makes the verdict inconclusive.
+  double decisive = 5.0, ambiguity = 3.0;
+  /// A further effect must remove `further` of the misfit its predecessors leave (beyond what the best set
+  /// explored leaves): a real second effect removes nearly all of it, a stand-in that absorbs the first effect's
+  /// approximation of the real physics only part. An explanation that removes less than `partial` of the misfit
+  /// beyond the noise leaves the verdict inconclusive (an effect outside the library, or several at once).
+  double further = 0.8, partial = 0.5;
+  /// A further effect's parameters must differ from nominal by this many standard deviations.
   double min_significance = 3.0;
-  std::vector<std::string> kinds;  ///< candidate kinds to consider (empty = all)
+  int max_iterations = 100;        ///< Ceres iterations per fit
+  double min_mac = 0.5;            ///< pairing: a measured mode pairs with a model mode of at least this MAC ...
+  double max_frequency_ratio = 1.5;  ///< ... within this frequency ratio, else it is unpaired (never forced)
+  std::vector<std::string> kinds;  ///< candidate kinds to consider (empty = all); unknown names are an error
+  std::vector<CandidateKind> extra_kinds;  ///< a host code's own kinds, considered with dynid's
   std::vector<int> sensor_nodes;   ///< nodes carrying sensors (sensor mass loading); empty = the measured nodes
   std::vector<int> suspension_nodes;  ///< free-free tests: suspension points (empty = the two farthest nodes)
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< direction (zero: -y for plane models, -z for space ones)
+  double gravity_acceleration = 9.81;                 ///< in the model's units
   bool si_units = true;            ///< label reported values in SI (kg, N, m); false: "(model units)"
   bool IsValid(std::string* why) const;
 };
 
-/// Step 1: where the data disagree with the model.
+/// Step 2: where the data disagree with the model.
 struct Localization {
   std::vector<MeasuredDof> dofs;   ///< measured DOFs (rows of the residuals)
-  Eigen::MatrixXd residuals;       ///< SEREP-reduced residual force per measured mode (dofs x modes)
-  Eigen::VectorXd pseudo;          ///< per DOF: geometric mean over modes of |R| / ||R||
+  Eigen::MatrixXd residuals;       ///< eq. (6) on the SEREP-reduced model, per measured mode (dofs x modes)
+  Eigen::VectorXd pseudo;          ///< eqs. (7)-(8) per DOF
   struct NodeShare {
     int node = 0;                  ///< user id
     double share = 0;              ///< share of the residual force (sum over the node's DOFs of pseudo^2)
@@ -98,64 +78,120 @@ struct Localization {
   };
   std::vector<NodeShare> nodes;    ///< sorted by share, largest first
   double concentration = 0;        ///< share of the largest 20 % of nodes (1 = all in one spot)
-  bool localized = false;
+  bool localized = false;          ///< three or more measured nodes and over half the share in the top fifth
   Eigen::Vector3d direction_share = Eigen::Vector3d::Zero();  ///< x, y, z shares of the residual
-  double mass_alignment = 0;       ///< mean over modes of cos(R_k, lambda_k M~ u_k): ~ +-1 mass-like, ~0 stiffness-like
+  double mass_alignment = 0;       ///< mean over modes of |cos(R_k, lambda_k M~ u_k)|: ~1 mass-like, ~0 stiffness-like
   double mean_frequency_error_pct = 0;  ///< mean (model - measured) / measured
-  std::string nature;              ///< "stiffness" or "mass" (dominant), from the screening and the alignment
-  std::string words;               ///< the summary in one or two sentences
+  Nature nature = Nature::kStiffness;   ///< the nature of the candidates that explain most in the screening
 };
 
-/// One scored hypothesis (a candidate, a combination, the nominal model or the recalibration).
+/// One scored hypothesis: a candidate, or a set of them.
 struct ScoredHypothesis {
-  std::string kind, description;
+  std::string kind;                ///< the candidate's kind ("+"-joined for a set)
+  Nature nature = Nature::kStiffness;
+  std::string description;
   Site site;
   bool global = false;
   double screening = 0;            ///< linearised chi-square drop of the screening (local candidates)
   bool fitted = false;
   double chi2 = 0;                 ///< whitened residual sum of squares after the fit
   int parameters = 0;
-  double bic = 0, delta_bic = 0;   ///< score (lower is better) and its improvement over the nominal model
+  /// ln of the Bayes factor against the model as given (Laplace approximation, physical priors, the noise scaled
+  /// to the misfit nothing explains): > `decisive` is a decisive improvement.
+  double log_evidence = -std::numeric_limits<double>::infinity();
+  double explained = 0;            ///< share of the model's misfit beyond the noise that the hypothesis removes
+  double significance = 0;         ///< smallest |theta - nominal| / std over its parameters
   std::vector<PhysicalValue> values;
-  std::string finding;
+  std::string finding;             ///< the candidate's own sentence (Candidate::finding)
   double max_freq_error_pct = 0, mean_mac = 0;
   bool at_bound = false;           ///< a parameter ended on a bound (the hypothesis strains to fit)
 };
 
 struct FitQuality {
   Eigen::VectorXd measured_hz, model_hz, mac;
-  double max_freq_error_pct = 0;  ///< over the modes that pair (MAC >= 0.5)
-  int unpaired = 0;                ///< measured modes with no model mode of MAC >= 0.5
-  double mean_mac = 0, chi2 = 0;
+  std::vector<char> paired;        ///< per measured mode: a plausible partner (MAC, frequency ratio)
+  /// Largest |model - measured| / measured over the modes the model as given pairs (the same modes before and
+  /// after, so that the two numbers compare).
+  double max_freq_error_pct = 0;
+  int unpaired = 0;                ///< measured modes without a plausible model partner
+  double mean_mac = 0, chi2 = 0;   ///< mean MAC over the measured modes (0 for unpaired ones)
+};
+
+/// What the noise levels are and where they come from.
+struct NoiseModel {
+  enum class Source { kStated, kData, kDefault };
+  double frequency = 0, shape = 0;  ///< relative std (frequencies; shape entries relative to each mode's largest)
+  Source frequency_source = Source::kStated, shape_source = Source::kStated;
+};
+
+/// A measured mode discovery does not use, and why.
+struct SetAside {
+  int mode = 0;                    ///< 0-based index in the measured data
+  double frequency_hz = 0;
+  /// kRigidBody: a free-free test's rigid-body motion on its suspension (below the first elastic mode, shaped
+  /// like the model's rigid-body motions). kNoPartner: the model as given has no mode of that shape within the
+  /// plausible frequency ratio (a local mode of what is missing, or a spurious identification); after discovery,
+  /// `paired_after` tells whether the findings predict it.
+  enum class Reason { kRigidBody, kNoPartner } reason = Reason::kRigidBody;
+  double mac = 0;                  ///< kRigidBody: MAC with the rigid-body motions; kNoPartner: best MAC
+  bool paired_after = false;
+  double model_hz_after = 0, mac_after = 0;
+};
+
+enum class Verdict { kConsistent, kMissingPhysics, kInconclusive };
+const char* to_string(Verdict v);  // "consistent", "missing_physics", "inconclusive"
+
+/// Why the verdict is what it is.
+enum class VerdictReason {
+  kWithinNoise,           ///< consistent: the model fits the data within the noise
+  kExplained,             ///< missing physics: the findings are decisive and explain the misfit
+  kNothingDecisive,       ///< inconclusive: a misfit no candidate explains decisively
+  kPartlyExplained,       ///< inconclusive: the best explanation leaves most of the misfit
+  kRivals,                ///< inconclusive: a different explanation fits about as well
+};
+const char* to_string(VerdictReason r);  // "within_noise", ...
+
+/// One step of the selection, for the record: an effect added or removed, and the score after it.
+struct SelectionStep {
+  enum class Action { kStart, kAdd, kRemove } action = Action::kAdd;
+  std::string description;         ///< the effect
+  double log_evidence = 0, explained = 0, max_freq_error_pct = 0, mean_mac = 0;
 };
 
 struct DiscoverySummary {
-  std::string verdict;             ///< "missing_physics", "consistent" or "inconclusive"
-  std::string explanation;         ///< why, in words, with the evidence
+  Verdict verdict = Verdict::kConsistent;
+  VerdictReason reason = VerdictReason::kWithinNoise;
+  NoiseModel noise;
+  std::vector<SetAside> set_aside;
   Localization localization;
-  std::vector<ScoredHypothesis> findings;    ///< the accepted effects, in the order they were added
-  std::vector<ScoredHypothesis> candidates;  ///< every hypothesis scored, best first (single effects)
-  ScoredHypothesis recalibration;            ///< E and rho recalibrated globally
+  /// The explanation: the accepted effects, most important first (by the evidence lost without each). Each
+  /// carries the values fitted in the combination; `combined` scores the set as a whole.
+  std::vector<ScoredHypothesis> findings;
+  ScoredHypothesis combined;
+  std::vector<SelectionStep> steps;          ///< how the explanation was reached
+  std::vector<ScoredHypothesis> candidates;  ///< every single candidate fitted, best first
+  std::vector<ScoredHypothesis> rivals;      ///< explanations of another kind or place within `ambiguity`
+  ScoredHypothesis recalibration;            ///< E and rho recalibrated globally (always scored)
   FitQuality before, after;
+  /// Share of the model's misfit beyond the noise (chi-square above its expectation at the noise model's
+  /// levels) that the findings remove.
+  double explained = 0;
   int data = 0;                    ///< whitened residuals (frequencies + shape entries)
-  double chi2_per_datum_before = 0;     ///< max of the frequency and the shape parts (see min_misfit)
-  double chi2_frequency_before = 0, chi2_shape_before = 0;  ///< per datum
+  double chi2_frequency_before = 0, chi2_shape_before = 0;  ///< per datum, at the noise model's levels
+  double noise_scale = 1;          ///< sqrt of the misfit per datum nothing explains (>= 1): the evidence's noise
   int eigen_solves = 0;
   double seconds = 0;
   std::vector<std::string> warnings;
 };
 
-/// The candidate library placed on a model: every local candidate at every admissible site and the global ones
-/// (filtered by options.kinds). Exposed so host codes can inspect or extend it.
+/// The candidate library placed on a model: every candidate of the kinds in options.kinds (all if empty) among
+/// dynid's and options.extra_kinds. Exposed so host codes can inspect it.
 std::vector<std::unique_ptr<Candidate>> candidate_library(const Model& model, const ModalData& measured,
                                                           const DiscoveryOptions& options);
 
-/// Adds the candidates' parameters (kCustom, with their bounds) and terms to `pm`, in order; returns the index of
-/// each candidate's first parameter. For host codes that fit or evaluate candidates themselves.
-std::vector<int> install_candidates(ParametricModel* pm, const std::vector<const Candidate*>& set);
-
-/// Runs the four steps. `extra` candidates (a host code's own) are considered with the library's.
-/// Throws InputError for data that does not fit the model or invalid options.
+/// Runs the stages. `extra` candidates (a host code's own, already placed) are considered with the library's.
+/// Throws InputError for invalid options or data that does not fit the model, NumericalError when the model
+/// itself cannot be solved.
 DiscoverySummary discover(const Model& model, const ModalData& measured, const DiscoveryOptions& options,
                           std::vector<std::unique_ptr<Candidate>> extra = {});
 

@@ -40,6 +40,12 @@ struct FitOptions {
   /// are noisy), relative step (exact data converge here) and gradient.
   double function_tolerance = 1e-8, parameter_tolerance = 1e-10, gradient_tolerance = 1e-14;
   double min_mac = 0.5;           ///< pairing threshold
+  /// Pairing plausibility: partners further apart in frequency than this factor are not paired (0 = no bound).
+  double max_frequency_ratio = 0;
+  /// Model modes the sensors cannot see are not pairing partners: those whose mean square at the measured DOFs
+  /// is below this share of their mean square over all translational DOFs (axial or out-of-plane modes under
+  /// transverse or in-plane sensors), whose MAC with any measurement is noise.
+  double min_visibility = 0.01;
   int extra_modes = 10;           ///< model modes computed beyond the measured ones (pairing, expansion)
   /// Models up to this many DOFs are solved densely with every mode (exact shape derivatives); larger ones by
   /// shift-invert Lanczos for the modes needed, shape derivatives with a static correction. With hundreds of
@@ -71,6 +77,11 @@ struct FitSummary {
   /// sqrt(chi2 / (data - free parameters)) at the solution: 1 when the stated noise is right. `stddev` assumes
   /// the stated noise; stddev * residual_scale is the a-posteriori estimate when the noise is not known.
   double residual_scale = std::numeric_limits<double>::quiet_NaN();
+  /// J^T J of the whitened residuals over the free parameters at the solution (without regularization): the
+  /// inverse posterior covariance at the stated noise (Laplace approximations of the evidence).
+  Eigen::MatrixXd information;
+  double final_chi2_frequency = 0;  ///< the frequency residuals' part of 2 final_cost
+  std::vector<char> final_forced;   ///< per measured mode: paired below min_mac (or the ratio bound) at the solution
   std::vector<int> at_bound;    ///< parameters that ended on a bound
   std::vector<std::string> warnings;
   std::string report;           ///< Ceres FullReport()
@@ -116,7 +127,9 @@ struct Correlation {
   Eigen::VectorXd measured_hz, model_hz, mac;
   std::vector<int> model_mode;  ///< paired elastic model mode (0-based, rigid modes not counted), -1 if none
 };
+/// The pairing follows `options` (min_mac, max_frequency_ratio, min_visibility); a measured mode without a plausible
+/// partner has model_mode -1 and, in model_hz and mac, the values of the mode it would be forced to.
 Correlation correlate(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta,
-                      double min_mac = 0.5);
+                      const FitOptions& options);
 
 }  // namespace dynid

@@ -38,6 +38,14 @@ ExpectCheck check_expectation(const DiscoverSpec::Expect& e, const DiscoverySumm
 /// A site in short form: "n4" + sep + "e37".
 std::string site_label(const Site& s, const std::string& sep);
 
+/// The words of a discovery, from its data (one story: the verdict, the findings with their values, the fit and
+/// the evidence, and what would decide when it is inconclusive).
+std::string discovery_explanation(const DiscoverySummary& s);
+/// Where the residual forces are, and of what nature.
+std::string localization_words(const DiscoverySummary& s);
+/// One sentence per measured mode set aside (a rigid-body mode on the suspension, a mode without a partner).
+std::vector<std::string> set_aside_words(const DiscoverySummary& s);
+
 nlohmann::ordered_json discovery_json(const Case& c, const DiscoveryData& d, const DiscoverySummary& s,
                                       const ExpectCheck* check);
 

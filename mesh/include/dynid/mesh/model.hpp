@@ -33,6 +33,11 @@ enum class ElementType { Beam2D, Frame2D, Frame3D, PointMass, Spring, Matrix };
 /// "beam2d", "frame2d", "frame3d", "point_mass", "spring", "matrix"
 std::string_view element_type_name(ElementType t);
 bool parse_element_type(std::string_view name, ElementType* out);
+/// Beams and frames: two-node members with a section, an axis and bending (the others are point masses,
+/// springs and matrix elements).
+constexpr bool is_member(ElementType t) {
+  return t == ElementType::Beam2D || t == ElementType::Frame2D || t == ElementType::Frame3D;
+}
 
 enum class MassType { Consistent, Lumped };
 
@@ -171,6 +176,14 @@ class Model : public ElementSource {
   /// Beams and frames: the consistent geometric stiffness of a unit axial tension, in global coordinates on the
   /// element's DOFs (int N'^T N' dx per bending plane). Scaled by rho I it is also the Rayleigh rotary inertia.
   Eigen::MatrixXd unit_geometric_stiffness(int e) const;
+  /// Beams and frames: the global translation (x, y, z) of the point at xi in [0, 1] along the member's axis
+  /// from the element's DOFs (element_dof_types order), with the shape functions of its stiffness: linear
+  /// axially, cubic Hermite transversely (Euler-Bernoulli). A 3 x n matrix N(xi); its derivative in xi in
+  /// `dN` when not null. A mass m fixed at that point adds m N^T N to the mass matrix (consistently).
+  Eigen::MatrixXd member_point_interpolation(int e, double xi, Eigen::MatrixXd* dN = nullptr) const;
+  /// Beams and frames: the axial force (tension > 0) that element displacements `u` (element_dof_types order,
+  /// global coordinates) produce: E A / L times the elongation.
+  double member_axial_force(int e, const Eigen::VectorXd& u) const;
 
   /// Geometric rigid-body motions restricted to the free DOFs: columns are unit translations along x, y, z and
   /// unit rotations about x, y, z through the centroid of the nodes; columns that vanish on the free DOFs

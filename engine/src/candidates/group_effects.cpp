@@ -1,0 +1,127 @@
+// axial_preload and distributed_mass: effects spread over all members or one element group (a tension or
+// compression the model leaves out; non-structural mass such as slabs, cladding, fittings).
+#include <cmath>
+
+#include "candidates/common.hpp"
+
+namespace dynid::internal {
+namespace {
+
+// A global candidate acting on a set of elements (all members, or a group): its site is those elements.
+class OnElements : public Candidate {
+ public:
+  OnElements(const Model& m, std::string group, std::vector<int> els) : group_(std::move(group)), els_(std::move(els)) {
+    for (int e : els_) site_.elements.push_back(m.elements()[e].id);
+  }
+  Site site() const override { return site_; }
+  bool global() const override { return true; }
+
+ protected:
+  std::string group_;
+  std::vector<int> els_;
+
+ private:
+  Site site_;
+};
+
+// P int N'^T N' (the consistent geometric stiffness) on every element of the group; unit: the Euler load
+// pi^2 EI / Lg^2 of the group's extent Lg.
+class AxialPreload : public OnElements {
+ public:
+  AxialPreload(const Model& m, std::string group, std::vector<int> els) : OnElements(m, std::move(group), std::move(els)) {
+    double EI = 0;
+    Eigen::Vector3d a = Eigen::Vector3d::Constant(1e300), b = -a;
+    for (int e : els_) {
+      EI += member(m, e).EI / static_cast<double>(els_.size());
+      for (int k = 0; k < 2; ++k) {
+        a = a.cwiseMin(m.nodes()[m.element_nodes(e)[k]].x);
+        b = b.cwiseMax(m.nodes()[m.element_nodes(e)[k]].x);
+      }
+    }
+    const double Lg = std::max((b - a).norm(), 1e-12);
+    pref_ = M_PI * M_PI * EI / (Lg * Lg);
+  }
+  std::string kind() const override { return "axial_preload"; }
+  Nature nature() const override { return Nature::kStiffness; }
+  std::string description() const override { return "axial preload (geometric stiffness) in " + group_words(group_); }
+  std::vector<CandidateParameter> parameters() const override { return {{"force", 0.0, -0.9, 200.0, 20.0}}; }
+  std::vector<CustomTerm> terms(const Model& m, int first) const override {
+    std::vector<CustomTerm> out;
+    for (int e : els_) {
+      std::vector<int> dofs;
+      m.element_dofs(e, &dofs);
+      out.push_back(linear_term(dofs, pref_ * m.unit_geometric_stiffness(e), {}, first));
+    }
+    return out;
+  }
+  std::vector<PhysicalValue> physical(const Eigen::VectorXd& th, const Eigen::VectorXd& sd) const override {
+    return {{"axial force", "N", pref_ * th[0], pref_ * sd[0]}};
+  }
+  std::string finding(const std::vector<PhysicalValue>& v) const override {
+    return group_words(group_) + (v[0].value >= 0 ? " carry an axial tension" : " carry an axial compression") +
+           " the model leaves out: " + with_std(PhysicalValue{v[0].name, v[0].unit, std::abs(v[0].value), v[0].std});
+  }
+
+ private:
+  double pref_ = 1;
+};
+
+// Translational mass rho A int N^T N added in proportion to the members' own: a fraction of the group's mass.
+class NonStructuralMass : public OnElements {
+ public:
+  NonStructuralMass(const Model& m, std::string group, std::vector<int> els) : OnElements(m, std::move(group), std::move(els)) {
+    double len = 0;
+    for (int e : els_) {
+      const Member mb = member(m, e);
+      mass_ += mb.rhoA * mb.L;
+      len += mb.L;
+    }
+    per_length_ = mass_ / std::max(len, 1e-300);
+  }
+  std::string kind() const override { return "distributed_mass"; }
+  Nature nature() const override { return Nature::kMass; }
+  std::string description() const override { return "distributed non-structural mass on " + group_words(group_); }
+  std::vector<CandidateParameter> parameters() const override { return {{"fraction", 0.0, 0.0, 5.0, 0.5}}; }
+  std::vector<CustomTerm> terms(const Model& m, int first) const override {
+    std::vector<CustomTerm> out;
+    for (int e : els_) {
+      const Member mb = member(m, e);
+      out.push_back(linear_term(mb.dofs, {}, mb.Mt, first));
+    }
+    return out;
+  }
+  std::vector<PhysicalValue> physical(const Eigen::VectorXd& th, const Eigen::VectorXd& sd) const override {
+    return {{"mass per length", "kg/m", per_length_ * th[0], per_length_ * sd[0]}, {"total", "kg", mass_ * th[0], mass_ * sd[0]}};
+  }
+  std::string finding(const std::vector<PhysicalValue>& v) const override {
+    return group_words(group_) + " carry non-structural mass (cladding, fittings, payload): " + with_std(v[0]) + " (" +
+           fmt_value(v[1].value, 3) + " kg in all)";
+  }
+
+ private:
+  double mass_ = 0, per_length_ = 0;
+};
+
+template <class C>
+std::vector<std::unique_ptr<Candidate>> per_group(const CandidateContext& c) {
+  std::vector<std::unique_ptr<Candidate>> out;
+  for (const std::string& g : member_groups(*c.model)) {
+    std::vector<int> els = group_members(*c.model, g);
+    if (!els.empty()) out.push_back(std::make_unique<C>(*c.model, g, std::move(els)));
+  }
+  return out;
+}
+
+}  // namespace
+
+CandidateKind axial_preload_kind() {
+  return {"axial_preload", Nature::kStiffness, "an axial force (geometric stiffness) in all members or one group",
+          per_group<AxialPreload>};
+}
+
+CandidateKind distributed_mass_kind() {
+  return {"distributed_mass", Nature::kMass, "non-structural mass spread over all members or one group",
+          per_group<NonStructuralMass>};
+}
+
+}  // namespace dynid::internal

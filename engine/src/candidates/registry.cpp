@@ -1,0 +1,182 @@
+// The candidate kinds dynid ships: one line per kind (each kind is one file in this folder).
+#include "candidates/registry.hpp"
+
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "candidates/common.hpp"
+#include "dynid/engine/modal.hpp"
+#include "dynid/mesh/error.hpp"
+
+namespace dynid {
+namespace internal {
+
+CandidateKind lumped_mass_kind();
+CandidateKind element_point_mass_kind();
+CandidateKind grounded_spring_kind();
+CandidateKind rotational_spring_kind();
+CandidateKind semi_rigid_joint_kind();
+CandidateKind flexible_support_kind();
+CandidateKind element_stiffness_kind();
+CandidateKind element_mass_kind();
+CandidateKind member_damage_kind();
+CandidateKind shear_deformation_kind();
+CandidateKind axial_preload_kind();
+CandidateKind self_weight_kind();
+CandidateKind distributed_mass_kind();
+CandidateKind sensor_mass_kind();
+CandidateKind suspension_stiffness_kind();
+
+namespace {
+
+// Chains of collinear members of one group and type joined at unsupported nodes where only they meet.
+std::vector<std::vector<int>> member_chains(const Model& m, const std::vector<std::vector<std::pair<int, int>>>& ends) {
+  const int nn = static_cast<int>(m.nodes().size());
+  auto dir = [&](int e) {
+    const auto& n = m.element_nodes(e);
+    return Eigen::Vector3d((m.nodes()[n[1]].x - m.nodes()[n[0]].x).normalized());
+  };
+  // A node continues a chain when exactly two members of the same group and type meet there in line, and the
+  // node has no restrained DOF.
+  std::vector<char> through(static_cast<std::size_t>(nn), 0);
+  for (int n = 0; n < nn; ++n) {
+    if (ends[n].size() != 2) continue;
+    const int a = ends[n][0].first, b = ends[n][1].first;
+    const Element &ea = m.elements()[a], &eb = m.elements()[b];
+    bool restrained = false;
+    for (int t = 0; t < kNumDofTypes; ++t)
+      restrained = restrained || ((m.dof_map().active(n) & (1u << t)) && m.dof_map().eq(n, static_cast<Dof>(t)) < 0);
+    through[n] = !restrained && ea.group == eb.group && ea.type == eb.type && std::abs(dir(a).dot(dir(b))) > 1 - 1e-9;
+  }
+  std::vector<char> seen(static_cast<std::size_t>(m.num_elements()), 0);
+  std::vector<std::vector<int>> out;
+  for (int e = 0; e < m.num_elements(); ++e) {
+    if (seen[e] || !is_member(m.elements()[e].type)) continue;
+    // Walk to one end of e's chain, then collect along it.
+    int cur = e, from = m.element_nodes(e)[1];
+    for (int guard = 0; guard < m.num_elements(); ++guard) {
+      const int n = m.element_nodes(cur)[0] == from ? m.element_nodes(cur)[1] : m.element_nodes(cur)[0];
+      if (!through[n]) break;
+      const int next = ends[n][0].first == cur ? ends[n][1].first : ends[n][0].first;
+      if (next == e) break;  // a closed ring
+      from = n;
+      cur = next;
+    }
+    // cur is an end element; its far node from the chain is the end node.
+    std::vector<int> chain;
+    int end_node = m.element_nodes(cur)[0] == from ? m.element_nodes(cur)[1] : m.element_nodes(cur)[0];
+    int el = cur;
+    for (int guard = 0; guard <= m.num_elements() && el >= 0 && !seen[el]; ++guard) {
+      seen[el] = 1;
+      chain.push_back(el);
+      const int n = m.element_nodes(el)[0] == end_node ? m.element_nodes(el)[1] : m.element_nodes(el)[0];
+      if (!through[n]) break;
+      const int next = ends[n][0].first == el ? ends[n][1].first : ends[n][0].first;
+      end_node = n;
+      el = next;
+    }
+    out.push_back(std::move(chain));
+  }
+  return out;
+}
+
+}  // namespace
+
+CandidateContext make_context(const Model& model, const ModalData& measured, const std::vector<int>& sensor_ids,
+                              const std::vector<int>& suspension_ids, const Eigen::Vector3d& gravity) {
+  CandidateContext c;
+  c.model = &model;
+  c.measured = &measured;
+  const int nn = static_cast<int>(model.nodes().size());
+  c.member_ends.assign(static_cast<std::size_t>(nn), {});
+  c.node_used.assign(static_cast<std::size_t>(nn), 0);
+  for (int e = 0; e < model.num_elements(); ++e) {
+    const Element& el = model.elements()[e];
+    for (int k = 0; k < el.num_nodes; ++k) c.node_used[model.element_nodes(e)[k]] = 1;
+    if (el.type == ElementType::Matrix && el.matrix) {
+      for (const auto& [id, d] : el.matrix->dofs) c.node_used[model.node_index(id)] = 1;
+      for (int id : el.matrix->nodes) c.node_used[model.node_index(id)] = 1;
+    }
+    if (el.type == ElementType::PointMass) c.structure_mass += el.mass;
+    if (el.type == ElementType::Matrix) c.structure_mass += translational_mass(model, e);
+    if (!is_member(el.type)) continue;
+    for (int k = 0; k < 2; ++k) c.member_ends[model.element_nodes(e)[k]].push_back({e, k});
+    const Member mb = member(model, e);
+    c.structure_mass += mb.rhoA * mb.L;
+  }
+  c.members = member_chains(model, c.member_ends);
+  const AssembledSystem sys = assemble_system(model);
+  c.stiffness_diagonal = sys.K.diagonal();
+  auto resolve = [&](const std::vector<int>& ids, const char* what) {
+    std::vector<int> out;
+    for (int id : ids) {
+      const int n = model.node_index(id);
+      if (n < 0) throw InputError(std::string("discover: ") + what + " node " + std::to_string(id) + " does not exist");
+      out.push_back(n);
+    }
+    return out;
+  };
+  c.sensor_nodes = resolve(sensor_ids, "sensor");
+  if (c.sensor_nodes.empty()) {
+    std::set<int> s;
+    for (const MeasuredDof& d : measured.dofs)
+      if (model.node_index(d.node) >= 0) s.insert(model.node_index(d.node));
+    c.sensor_nodes.assign(s.begin(), s.end());
+  }
+  if (model.free_free()) {
+    c.suspension_nodes = resolve(suspension_ids, "suspension");
+    if (c.suspension_nodes.empty()) {  // the two nodes farthest apart
+      double best = -1;
+      for (int a = 0; a < nn; ++a)
+        for (int b = a + 1; b < nn; ++b) {
+          const double d = (model.nodes()[a].x - model.nodes()[b].x).norm();
+          if (c.node_used[a] && c.node_used[b] && d > best) best = d, c.suspension_nodes = {a, b};
+        }
+    }
+  }
+  if (gravity.norm() > 0) {
+    c.gravity = gravity.normalized();
+  } else {
+    bool space = false;
+    for (const Element& el : model.elements()) space = space || el.type == ElementType::Frame3D;
+    c.gravity = space ? Eigen::Vector3d(0, 0, -1) : Eigen::Vector3d(0, -1, 0);
+  }
+  return c;
+}
+
+std::vector<std::unique_ptr<Candidate>> place_candidates(const CandidateContext& c, const std::vector<CandidateKind>& registry,
+                                                         const std::vector<std::string>& kinds) {
+  for (const std::string& k : kinds) {
+    bool known = false;
+    for (const CandidateKind& r : registry) known = known || r.name == k;
+    if (!known) {
+      std::string list;
+      for (const CandidateKind& r : registry) list += (list.empty() ? "" : ", ") + r.name;
+      throw InputError("discover: unknown candidate kind '" + k + "' (known kinds: " + list + ")");
+    }
+  }
+  std::vector<std::unique_ptr<Candidate>> out;
+  for (const CandidateKind& r : registry) {
+    bool want = kinds.empty();
+    for (const std::string& k : kinds) want = want || k == r.name;
+    if (!want) continue;
+    for (auto& cand : r.place(c)) out.push_back(std::move(cand));
+  }
+  return out;
+}
+
+}  // namespace internal
+
+const std::vector<CandidateKind>& builtin_candidate_kinds() {
+  using namespace internal;
+  static const std::vector<CandidateKind> kinds = {
+      lumped_mass_kind(),        element_point_mass_kind(), grounded_spring_kind(),  rotational_spring_kind(),
+      semi_rigid_joint_kind(),   flexible_support_kind(),   element_stiffness_kind(), element_mass_kind(),
+      member_damage_kind(),      shear_deformation_kind(),  axial_preload_kind(),     self_weight_kind(),
+      distributed_mass_kind(),   sensor_mass_kind(),        suspension_stiffness_kind(),
+  };
+  return kinds;
+}
+
+}  // namespace dynid

@@ -1,0 +1,26 @@
+// The registry of candidate kinds and the context they are placed with (internal).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "dynid/engine/candidate.hpp"
+
+namespace dynid::internal {
+
+/// The context of a discovery: scales, members, sensors, suspension points and gravity of `model`.
+/// `sensor_nodes`, `suspension_nodes`: user ids (empty = the measured nodes; the two nodes farthest apart);
+/// `gravity`: a direction (zero = -y for plane models, -z for space models). Throws InputError for unknown nodes.
+CandidateContext make_context(const Model& model, const ModalData& measured, const std::vector<int>& sensor_nodes,
+                              const std::vector<int>& suspension_nodes, const Eigen::Vector3d& gravity);
+
+/// Every candidate of the kinds named in `kinds` (empty = all) among `registry`, placed on the model. Throws
+/// InputError naming a kind that is not in the registry, with the known ones.
+std::vector<std::unique_ptr<Candidate>> place_candidates(const CandidateContext& c, const std::vector<CandidateKind>& registry,
+                                                         const std::vector<std::string>& kinds);
+
+/// The classic alternative: E and rho of the whole model.
+std::unique_ptr<Candidate> make_recalibration(const Model& model);
+
+}  // namespace dynid::internal

@@ -1,0 +1,302 @@
+// discover(): the driver over the stages (stages.hpp), and the verdict.
+#include "dynid/engine/discovery.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+#include "candidates/registry.hpp"
+#include "discovery/stages.hpp"
+#include "dynid/mesh/error.hpp"
+
+namespace dynid {
+
+const char* to_string(Verdict v) {
+  switch (v) {
+    case Verdict::kConsistent: return "consistent";
+    case Verdict::kMissingPhysics: return "missing_physics";
+    case Verdict::kInconclusive: return "inconclusive";
+  }
+  return "?";
+}
+
+const char* to_string(VerdictReason r) {
+  switch (r) {
+    case VerdictReason::kWithinNoise: return "within_noise";
+    case VerdictReason::kExplained: return "explained";
+    case VerdictReason::kNothingDecisive: return "nothing_decisive";
+    case VerdictReason::kPartlyExplained: return "partly_explained";
+    case VerdictReason::kRivals: return "rivals";
+  }
+  return "?";
+}
+
+bool DiscoveryOptions::IsValid(std::string* why) const {
+  auto fail = [&](const char* m) {
+    if (why) *why = m;
+    return false;
+  };
+  auto stated_ok = [](double v) { return std::isnan(v) || (std::isfinite(v) && v > 0); };
+  if (!stated_ok(frequency_noise) || !stated_ok(shape_noise)) return fail("noise levels must be > 0 (or not stated)");
+  if (!(default_frequency_noise > 0) || !(default_shape_noise > 0)) return fail("default noise levels must be > 0");
+  if (!(consistency_level > 0 && consistency_level < 1)) return fail("consistency_level must be in (0, 1)");
+  if (screen_fit < 1) return fail("screen_fit must be >= 1");
+  if (max_effects < 1) return fail("max_effects must be >= 1");
+  if (!(decisive > 0) || !(ambiguity >= 0)) return fail("decisive must be > 0 and ambiguity >= 0");
+  if (!(further > 0 && further <= 1) || !(partial >= 0 && partial <= 1)) return fail("further must be in (0, 1], partial in [0, 1]");
+  if (!(min_significance >= 0)) return fail("min_significance must be >= 0");
+  if (max_iterations < 1) return fail("max_iterations must be >= 1");
+  if (!(min_mac > 0 && min_mac < 1)) return fail("min_mac must be in (0, 1)");
+  if (!(max_frequency_ratio > 1)) return fail("max_frequency_ratio must be > 1");
+  if (!gravity.allFinite() || !(gravity_acceleration > 0)) return fail("gravity must be finite, its acceleration > 0");
+  for (const CandidateKind& k : extra_kinds)
+    if (k.name.empty() || !k.place) return fail("every extra candidate kind needs a name and a place function");
+  return true;
+}
+
+std::vector<std::unique_ptr<Candidate>> candidate_library(const Model& model, const ModalData& measured,
+                                                          const DiscoveryOptions& o) {
+  const CandidateContext c = internal::make_context(model, measured, o.sensor_nodes, o.suspension_nodes, o.gravity);
+  std::vector<CandidateKind> registry = builtin_candidate_kinds();
+  registry.insert(registry.end(), o.extra_kinds.begin(), o.extra_kinds.end());
+  return internal::place_candidates(c, registry, o.kinds);
+}
+
+namespace {
+
+using namespace internal;
+
+// The chi-square quantile P(X > q) = alpha with k degrees of freedom (Wilson-Hilferty; a few per cent at k = 2,
+// far below the noise of the levels compared with it).
+double chi2_quantile(int k, double alpha) {
+  double lo = 0, hi = 40;  // the standard normal quantile z with P(Z > z) = alpha, by bisection
+  for (int it = 0; it < 200; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (0.5 * std::erfc(mid / std::sqrt(2.0)) > alpha ? lo : hi) = mid;
+  }
+  const double z = 0.5 * (lo + hi), c = 2.0 / (9.0 * std::max(k, 1));
+  return std::max(k, 1) * std::pow(1 - c + z * std::sqrt(c), 3);
+}
+
+// Whether the findings make the model predict the measured modes the model as given had no partner for.
+void check_set_aside(const Problem& p, const ModalData& measured, const SetFit& f, std::vector<SetAside>* aside) {
+  std::vector<int> idx;
+  for (const SetAside& s : *aside)
+    if (s.reason == SetAside::Reason::kNoPartner) idx.push_back(s.mode);
+  if (idx.empty() || !f.ok) return;
+  ModalData d = measured;
+  d.frequencies_hz.resize(static_cast<Eigen::Index>(idx.size()));
+  d.shapes.resize(measured.shapes.rows(), static_cast<Eigen::Index>(idx.size()));
+  for (std::size_t k = 0; k < idx.size(); ++k) {
+    d.frequencies_hz[static_cast<Eigen::Index>(k)] = measured.frequencies_hz[idx[k]];
+    d.shapes.col(static_cast<Eigen::Index>(k)) = measured.shapes.col(idx[k]);
+  }
+  d.damping_ratios.resize(0), d.mpc.resize(0), d.frequency_std_hz.resize(0), d.damping_std.resize(0), d.shape_std.resize(0);
+  ParametricModel pm(*p.model);
+  const std::vector<int> first = install_candidates(&pm, f.set);
+  Eigen::VectorXd th = pm.nominal();
+  for (std::size_t k = 0; k < f.set.size(); ++k) th.segment(first[k], f.theta[k].size()) = f.theta[k];
+  try {
+    const Correlation c = correlate(pm, d, th, p.fit);
+    std::size_t k = 0;
+    for (SetAside& s : *aside) {
+      if (s.reason != SetAside::Reason::kNoPartner) continue;
+      s.paired_after = c.model_mode[k] >= 0;
+      s.model_hz_after = c.model_hz[static_cast<Eigen::Index>(k)];
+      s.mac_after = c.mac[static_cast<Eigen::Index>(k)];
+      ++k;
+    }
+  } catch (const NumericalError&) {
+  }
+}
+
+// Whether two sets of effects tell different stories (an effect of one is unlike every effect of the other).
+bool different(const Model& m, const std::vector<const Candidate*>& a, const std::vector<const Candidate*>& b) {
+  auto like = [&](const Candidate* x, const std::vector<const Candidate*>& set) {
+    for (const Candidate* y : set) {
+      if (x->global() || y->global()) {
+        if (x->kind() == y->kind()) return true;
+        continue;
+      }
+      const Site sx = x->site(), sy = y->site();
+      std::vector<int> nx = sx.nodes, ny = sy.nodes;
+      for (int id : sx.elements) {
+        const int e = m.element_index(id);
+        for (int k = 0; k < m.elements()[e].num_nodes; ++k) nx.push_back(m.nodes()[m.element_nodes(e)[k]].id);
+      }
+      for (int id : sy.elements) {
+        const int e = m.element_index(id);
+        for (int k = 0; k < m.elements()[e].num_nodes; ++k) ny.push_back(m.nodes()[m.element_nodes(e)[k]].id);
+      }
+      const bool near = std::find_first_of(nx.begin(), nx.end(), ny.begin(), ny.end()) != nx.end();
+      const bool nature = x->nature() == y->nature() || x->nature() == Nature::kBoth || y->nature() == Nature::kBoth;
+      if (near && nature) return true;
+    }
+    return false;
+  };
+  for (const Candidate* x : a)
+    if (!like(x, b)) return true;
+  for (const Candidate* y : b)
+    if (!like(y, a)) return true;
+  return false;
+}
+
+}  // namespace
+
+DiscoverySummary discover(const Model& model, const ModalData& measured, const DiscoveryOptions& options,
+                          std::vector<std::unique_ptr<Candidate>> extra) {
+  const auto t0 = std::chrono::steady_clock::now();
+  DiscoverySummary S;
+  auto finish = [&]() {
+    S.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return S;
+  };
+  Problem p;
+  prepare(model, measured, options, std::move(extra), &p, &S);
+  if (p.modes < 2) {
+    S.verdict = Verdict::kInconclusive;
+    S.reason = VerdictReason::kNothingDecisive;
+    S.warnings.push_back("fewer than two measured modes have a plausible partner in the model (MAC >= " +
+                         std::to_string(options.min_mac) + " within a frequency ratio of " + std::to_string(options.max_frequency_ratio) +
+                         "): nothing can be compared");
+    return finish();
+  }
+
+  // ---- locate and screen ----
+  S.localization = locate(p);
+  const Screening sc = screen(p);
+  p.n = 0;
+  p.n = p.modes * (1 + static_cast<int>(p.data.dofs.size()));
+  S.data = p.n;
+  S.eigen_solves = 2;
+  const double chi2_0 = sc.chi2;
+  S.chi2_frequency_before = sc.chi2_frequency / p.modes;
+  S.chi2_shape_before = (chi2_0 - sc.chi2_frequency) / std::max(1, p.n - p.modes);
+  std::vector<char> forced0(sc.paired.size());
+  for (std::size_t k = 0; k < sc.paired.size(); ++k) forced0[k] = !sc.paired[k];
+  S.before = quality_of(p, sc.model_hz, sc.mac, chi2_0, forced0);
+  S.after = S.before;
+  {
+    Localization& L = S.localization;
+    L.mean_frequency_error_pct = 100.0 * ((sc.model_hz - p.data.frequencies_hz).array() / p.data.frequencies_hz.array()).mean();
+    double best_k = 0, best_m = 0;
+    for (std::size_t k = 0; k < p.library.size(); ++k) {
+      if (p.library[k]->global()) continue;
+      double& b = p.library[k]->nature() == Nature::kMass ? best_m : best_k;
+      b = std::max(b, sc.drop[k]);
+    }
+    L.nature = best_m > best_k ? Nature::kMass : Nature::kStiffness;
+  }
+  const bool consistent = sc.chi2_frequency <= chi2_quantile(p.modes, 0.5 * options.consistency_level) &&
+                          chi2_0 - sc.chi2_frequency <= chi2_quantile(std::max(1, p.n - p.modes), 0.5 * options.consistency_level);
+
+  // ---- fit the shortlisted candidates and the recalibration ----
+  const std::vector<int> list = shortlist(p, sc, S.localization);
+  std::vector<SetFit> singles(list.size());
+  SetFit recal;
+#pragma omp parallel for schedule(dynamic)
+  for (int k = 0; k <= static_cast<int>(list.size()); ++k) {
+    if (k == static_cast<int>(list.size())) recal = fit_set(p, {p.recalibration.get()});
+    else singles[k] = fit_set(p, {p.library[list[k]].get()});
+  }
+  for (const SetFit& f : singles) S.eigen_solves += f.evaluations;
+  S.eigen_solves += recal.evaluations;
+
+  Selection sel;
+  if (!consistent) sel = select(p, singles, chi2_0, S.before);
+  else {
+    sel.chi2_best = chi2_0;
+    for (const SetFit& f : singles)
+      if (f.ok && f.chi2 < sel.chi2_best) sel.chi2_best = f.chi2;
+  }
+  S.eigen_solves += sel.eigen_solves;
+  S.noise_scale = sel.scale;
+  auto relative = [&](const SetFit& f) {
+    const double span = chi2_0 - sel.chi2_best;
+    return f.ok && span > 0 ? std::clamp((chi2_0 - f.chi2) / span, 0.0, 1.0) : 0.0;
+  };
+  auto score = [&](const SetFit& f, std::size_t k) {
+    ScoredHypothesis h = scored(p, f, k);
+    h.log_evidence = log_evidence(p, f, chi2_0, sel.scale);
+    h.explained = relative(f);
+    h.significance = significance(f, k, sel.scale);
+    return h;
+  };
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    ScoredHypothesis h = score(singles[k], 0);
+    h.screening = sc.drop[list[k]];
+    S.candidates.push_back(std::move(h));
+  }
+  std::stable_sort(S.candidates.begin(), S.candidates.end(),
+                   [](const ScoredHypothesis& a, const ScoredHypothesis& b) { return a.log_evidence > b.log_evidence; });
+  S.recalibration = score(recal, 0);
+
+  // ---- decide ----
+  if (consistent) {
+    S.verdict = Verdict::kConsistent;
+    S.reason = VerdictReason::kWithinNoise;
+    return finish();
+  }
+  if (sel.fit.set.empty()) {
+    S.verdict = Verdict::kInconclusive;
+    S.reason = VerdictReason::kNothingDecisive;
+    return finish();
+  }
+  // The findings, most important first, each with the values fitted in the combination.
+  std::vector<std::size_t> order(sel.fit.set.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return sel.importance[a] > sel.importance[b]; });
+  for (std::size_t k : order) {
+    ScoredHypothesis h = score(sel.fit, k);
+    h.log_evidence = sel.importance[k];
+    S.findings.push_back(std::move(h));
+  }
+  S.combined = score(sel.fit, 0);
+  S.combined.kind.clear();
+  S.combined.description.clear();
+  for (std::size_t k : order) {
+    S.combined.kind += (S.combined.kind.empty() ? "" : "+") + sel.fit.set[k]->kind();
+    S.combined.description += (S.combined.description.empty() ? "" : "; ") + sel.fit.set[k]->description();
+  }
+  S.combined.parameters = sel.fit.parameters();
+  S.combined.values.clear();
+  S.combined.finding.clear();
+  S.combined.significance = S.findings.back().significance;
+  S.steps = sel.steps;
+  S.after = sel.fit.quality;
+  check_set_aside(p, measured, sel.fit, &S.set_aside);
+
+  // Rivals: complete explanations of other stories, and the recalibration, within `ambiguity` in evidence.
+  const double best = S.combined.log_evidence;
+  for (const SetFit& a : sel.alternatives) {
+    if (a.set.size() > sel.fit.set.size()) continue;
+    if (log_evidence(p, a, chi2_0, sel.scale) < best - options.ambiguity || !different(model, a.set, sel.fit.set)) continue;
+    ScoredHypothesis h = score(a, 0);
+    h.kind.clear();
+    h.description.clear();
+    for (const Candidate* c : a.set) {
+      h.kind += (h.kind.empty() ? "" : "+") + c->kind();
+      h.description += (h.description.empty() ? "" : "; ") + c->description();
+    }
+    S.rivals.push_back(std::move(h));
+  }
+  if (recal.ok && !recal.at_bound && S.recalibration.log_evidence >= best - options.ambiguity)
+    S.rivals.push_back(S.recalibration);
+  const double noise_floor = static_cast<double>(p.n);
+  const double absolute = chi2_0 > noise_floor ? (chi2_0 - sel.fit.chi2) / (chi2_0 - noise_floor) : 1.0;
+  S.explained = std::clamp(absolute, 0.0, 1.0);
+  if (!S.rivals.empty()) {
+    S.verdict = Verdict::kInconclusive;
+    S.reason = VerdictReason::kRivals;
+  } else if (absolute < options.partial) {
+    S.verdict = Verdict::kInconclusive;
+    S.reason = VerdictReason::kPartlyExplained;
+  } else {
+    S.verdict = Verdict::kMissingPhysics;
+    S.reason = VerdictReason::kExplained;
+  }
+  return finish();
+}
+
+}  // namespace dynid

@@ -1,0 +1,180 @@
+// Discovery, stage 4: fitting sets of candidates and scoring them by their evidence.
+#include <Eigen/Dense>
+#include <cmath>
+#include <limits>
+
+#include "discovery/stages.hpp"
+#include "dynid/mesh/error.hpp"
+
+namespace dynid::internal {
+
+int SetFit::parameters() const {
+  int n = 0;
+  for (const Eigen::VectorXd& t : theta) n += static_cast<int>(t.size());
+  return n;
+}
+
+FitQuality quality_of(const Problem& p, const Eigen::VectorXd& model_hz, const Eigen::VectorXd& mac, double chi2,
+                      const std::vector<char>& forced) {
+  FitQuality q;
+  q.measured_hz = p.data.frequencies_hz;
+  q.model_hz = model_hz;
+  q.mac = mac;
+  q.chi2 = chi2;
+  q.paired.assign(static_cast<std::size_t>(mac.size()), 1);
+  // Every mode used pairs plausibly with the model as given (prepare() set the others aside), so the largest
+  // frequency error is over the same modes before and after; a mode that loses its partner counts at the one
+  // it is forced to (a hypothesis that breaks a pairing shows as a worse fit, never as a better one).
+  for (Eigen::Index k = 0; k < mac.size(); ++k) {
+    if (static_cast<std::size_t>(k) < forced.size() && forced[static_cast<std::size_t>(k)]) {
+      q.paired[static_cast<std::size_t>(k)] = 0;
+      ++q.unpaired;
+    }
+    const double f = p.data.frequencies_hz[k];
+    q.max_freq_error_pct = std::max(q.max_freq_error_pct, 100.0 * std::abs(model_hz[k] - f) / f);
+  }
+  q.mean_mac = mac.size() ? mac.mean() : 0.0;
+  return q;
+}
+
+SetFit fit_set(const Problem& p, const std::vector<const Candidate*>& set, const std::vector<Eigen::VectorXd>& start) {
+  SetFit out;
+  out.set = set;
+  ParametricModel pm(*p.model);
+  const std::vector<int> first = install_candidates(&pm, set);
+  Eigen::VectorXd theta0 = pm.nominal();
+  for (std::size_t k = 0; k < start.size() && k < set.size(); ++k)
+    if (start[k].size()) theta0.segment(first[k], start[k].size()) = start[k];
+  FitSummary s;
+  try {
+    s = fit_parameters(pm, p.data, theta0, {}, p.fit);
+  } catch (const NumericalError&) {
+    return out;  // the model cannot be solved there (e.g. a release that leaves a mechanism)
+  }
+  out.evaluations = s.evaluations;
+  if (!std::isfinite(s.final_cost)) return out;
+  out.chi2 = 2.0 * s.final_cost;
+  out.information = s.information;
+  out.quality = quality_of(p, s.final_hz, s.final_mac, out.chi2, s.final_forced);
+  for (std::size_t k = 0; k < set.size(); ++k) {
+    const std::vector<CandidateParameter> ps = set[k]->parameters();
+    const Eigen::Index np = static_cast<Eigen::Index>(ps.size());
+    out.theta.push_back(s.theta.segment(first[k], np));
+    out.stddev.push_back(s.stddev.segment(first[k], np));
+    const double th = s.theta[first[k]], tol = 1e-6 * (ps[0].upper - ps[0].lower);
+    if (std::abs(th - ps[0].lower) < tol && ps[0].lower != ps[0].nominal) out.at_bound = true;
+    if (std::abs(th - ps[0].upper) < tol && ps[0].upper != ps[0].nominal) out.at_bound = true;
+  }
+  out.ok = true;
+  out.unpartnered_gain = unpartnered_gain(p, pm, s.theta);
+  return out;
+}
+
+double unpartnered_gain(const Problem& p, const ParametricModel& pm, const Eigen::VectorXd& theta) {
+  if (p.unpartnered.num_modes() == 0) return 0;
+  FitOptions fo = p.fit;
+  fo.objective = FitObjective::kCombined;
+  double gain = 0;
+  try {
+    // The whitened residuals of the unpartnered modes at theta, mode by mode (a paired mode's block: its
+    // frequency and shape entries; fit_parameters' residual layout).
+    FitProblem fp(pm, p.unpartnered, fo);
+    Eigen::VectorXd r;
+    if (!fp.residuals(theta, &r)) return 0;
+    const Correlation c = correlate(pm, p.unpartnered, theta, p.fit);
+    const Eigen::Index block = 1 + static_cast<Eigen::Index>(p.unpartnered.dofs.size());
+    for (int k = 0; k < p.unpartnered.num_modes(); ++k) {
+      if (c.model_mode[static_cast<std::size_t>(k)] < 0) continue;
+      const double chi2 = r.segment(k * block, block).squaredNorm();
+      gain += std::max(0.0, p.unpartnered_edge[k] - chi2);
+    }
+  } catch (const NumericalError&) {
+    return 0;
+  }
+  return gain;
+}
+
+namespace {
+
+double normal_cdf(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
+
+// ln of the prior density of one parameter at theta, and its precision (the Laplace approximation's prior term).
+// A normal of std tau around the nominal, truncated to the bounds; tau = 0: uniform on the bounds, whose precision
+// is taken as that of a normal of equal variance (12 / width^2).
+void prior(const CandidateParameter& q, double theta, double* log_density, double* precision) {
+  const double w = q.upper - q.lower;
+  if (!(q.prior_scale > 0)) {
+    *log_density = -std::log(w);
+    *precision = 12.0 / (w * w);
+    return;
+  }
+  const double t = q.prior_scale;
+  const double mass = normal_cdf((q.upper - q.nominal) / t) - normal_cdf((q.lower - q.nominal) / t);
+  const double z = (theta - q.nominal) / t;
+  *log_density = -0.5 * z * z - std::log(t * std::sqrt(2 * M_PI)) - std::log(std::max(mass, 1e-300));
+  *precision = 1.0 / (t * t);
+}
+
+}  // namespace
+
+double log_evidence(const Problem& p, const SetFit& f, double chi2_0, double scale) {
+  if (!f.ok) return -std::numeric_limits<double>::infinity();
+  const double s2 = scale * scale;
+  const int k = f.parameters();
+  Eigen::MatrixXd H = f.information / s2;
+  double occam = 0;
+  int i = 0;
+  for (std::size_t c = 0; c < f.set.size(); ++c) {
+    const std::vector<CandidateParameter> ps = f.set[c]->parameters();
+    for (std::size_t q = 0; q < ps.size(); ++q, ++i) {
+      double lp = 0, prec = 0;
+      prior(ps[q], f.theta[c][static_cast<Eigen::Index>(q)], &lp, &prec);
+      occam += lp;
+      H(i, i) += prec;
+    }
+    // A uniform prior over the kinds and over the kind's sites.
+    const auto it = p.sites_per_kind.find(f.set[c]->kind());
+    occam -= std::log(static_cast<double>(p.kinds)) + std::log(static_cast<double>(it == p.sites_per_kind.end() ? 1 : it->second));
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(H);
+  double logdet = 0;
+  for (Eigen::Index j = 0; j < k; ++j) logdet += std::log(std::max(ldlt.vectorD()[j], 1e-300));
+  occam += 0.5 * k * std::log(2 * M_PI) - 0.5 * logdet;
+  return (chi2_0 - f.chi2 + f.unpartnered_gain) / (2 * s2) + occam;
+}
+
+double significance(const SetFit& f, std::size_t k, double scale) {
+  if (!f.ok) return 0;
+  // The magnitude parameter (the first: a mass, a stiffness, a fraction) against its nominal.
+  const CandidateParameter q = f.set[k]->parameters()[0];
+  const double th = f.theta[k][0], sd = f.stddev[k][0] * scale;
+  const double tol = 1e-6 * (q.upper - q.lower);
+  if ((std::abs(th - q.lower) < tol && q.lower != q.nominal) || (std::abs(th - q.upper) < tol && q.upper != q.nominal))
+    return 0.0;  // on a bound: the hypothesis strains to fit
+  return std::isfinite(sd) && sd > 0 ? std::abs(th - q.nominal) / sd : 0.0;
+}
+
+ScoredHypothesis scored(const Problem& p, const SetFit& f, std::size_t k) {
+  const Candidate& c = *f.set[k];
+  ScoredHypothesis h;
+  h.kind = c.kind();
+  h.nature = c.nature();
+  h.description = c.description();
+  h.site = c.site();
+  h.global = c.global();
+  h.parameters = static_cast<int>(c.parameters().size());
+  h.fitted = f.ok;
+  if (!f.ok) return h;
+  h.chi2 = f.chi2;
+  h.values = c.physical(f.theta[k], f.stddev[k]);
+  if (!p.options.si_units)
+    for (PhysicalValue& v : h.values)
+      if (!v.unit.empty() && v.unit != "%") v.unit = "(model units)";
+  h.finding = c.finding(h.values);
+  h.max_freq_error_pct = f.quality.max_freq_error_pct;
+  h.mean_mac = f.quality.mean_mac;
+  h.at_bound = f.at_bound;
+  return h;
+}
+
+}  // namespace dynid::internal

@@ -1,0 +1,204 @@
+// Discovery, stage 1: the noise model, the measured modes set aside, the candidates.
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "candidates/common.hpp"
+#include "candidates/registry.hpp"
+#include "discovery/stages.hpp"
+#include "dynid/engine/modal.hpp"
+#include "dynid/mesh/error.hpp"
+
+namespace dynid::internal {
+
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+// A copy of `d` with only the modes in `keep`.
+ModalData select_modes(const ModalData& d, const std::vector<int>& keep) {
+  ModalData o = d;
+  const Eigen::Index n = static_cast<Eigen::Index>(keep.size());
+  o.frequencies_hz.resize(n);
+  o.shapes.resize(d.shapes.rows(), n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    o.frequencies_hz[j] = d.frequencies_hz[keep[static_cast<std::size_t>(j)]];
+    o.shapes.col(j) = d.shapes.col(keep[static_cast<std::size_t>(j)]);
+  }
+  auto pick = [&](const Eigen::VectorXd& src, Eigen::VectorXd* dst) {
+    if (src.size() != d.frequencies_hz.size()) return;
+    dst->resize(n);
+    for (Eigen::Index j = 0; j < n; ++j) (*dst)[j] = src[keep[static_cast<std::size_t>(j)]];
+  };
+  pick(d.damping_ratios, &o.damping_ratios);
+  pick(d.mpc, &o.mpc);
+  pick(d.frequency_std_hz, &o.frequency_std_hz);
+  pick(d.damping_std, &o.damping_std);
+  pick(d.shape_std, &o.shape_std);
+  return o;
+}
+
+}  // namespace
+
+NoiseModel noise_model(const ModalData& data, const DiscoveryOptions& o, std::vector<std::string>* warnings) {
+  NoiseModel nm;
+  const int p = data.num_modes();
+  if (std::isfinite(o.frequency_noise)) {
+    nm.frequency = o.frequency_noise;
+    nm.frequency_source = NoiseModel::Source::kStated;
+  } else if (data.frequency_std_hz.size() == p && p > 0) {
+    std::vector<double> rel;
+    for (int k = 0; k < p; ++k) rel.push_back(data.frequency_std_hz[k] / data.frequencies_hz[k]);
+    nm.frequency = median(rel);
+    nm.frequency_source = NoiseModel::Source::kData;
+  }
+  if (!(nm.frequency > 0)) {
+    nm.frequency = o.default_frequency_noise;
+    nm.frequency_source = NoiseModel::Source::kDefault;
+    warnings->push_back("the frequencies' noise is not stated and the data carry none: " +
+                        fmt_value(100 * nm.frequency, 3) + " % assumed (conservative: smaller mismatches go unnoticed); "
+                        "state frequency_noise for sharper conclusions");
+  }
+  if (std::isfinite(o.shape_noise)) {
+    nm.shape = o.shape_noise;
+    nm.shape_source = NoiseModel::Source::kStated;
+  } else if (data.shape_std.size() == p && p > 0) {
+    nm.shape = median(std::vector<double>(data.shape_std.data(), data.shape_std.data() + p));
+    nm.shape_source = NoiseModel::Source::kData;
+  }
+  if (!(nm.shape > 0)) {
+    nm.shape = o.default_shape_noise;
+    nm.shape_source = NoiseModel::Source::kDefault;
+    warnings->push_back("the mode shapes' noise is not stated and the data carry none: " + fmt_value(100 * nm.shape, 3) +
+                        " % of each mode's largest entry assumed; state shape_noise for sharper conclusions");
+  }
+  return nm;
+}
+
+std::vector<SetAside> rigid_body_modes(const Model& model, const ModalData& data) {
+  std::vector<SetAside> out;
+  if (!model.free_free()) return out;
+  const Eigen::MatrixXd R = model.free_rigid_body_modes();
+  if (R.cols() == 0) return out;
+  const std::vector<int> rows = measured_equations(model, data.dofs);
+  Eigen::MatrixXd Ra(static_cast<Eigen::Index>(rows.size()), R.cols());
+  for (std::size_t r = 0; r < rows.size(); ++r) Ra.row(static_cast<Eigen::Index>(r)) = R.row(rows[r]);
+  // Orthonormal basis of the rigid motions as the sensors see them.
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Ra, Eigen::ComputeThinU);
+  int rank = 0;
+  for (Eigen::Index i = 0; i < svd.singularValues().size(); ++i) rank += svd.singularValues()[i] > 1e-8 * svd.singularValues()[0];
+  if (rank == 0) return out;
+  const Eigen::MatrixXd Q = svd.matrixU().leftCols(rank);
+  // The first elastic frequency of the model: rigid-body modes on a suspension lie well below it.
+  EigenOptions eo;
+  eo.num_modes = std::min(model.num_dofs(), static_cast<int>(R.cols()) + 1);
+  if (model.num_dofs() <= 400) eo.method = EigenOptions::Method::kDense;
+  const ModalResult mr = modal_analysis(model, eo);
+  if (!mr.ok()) throw NumericalError("discover: modal analysis of the model failed: " + mr.summary.message);
+  double f1 = 0;
+  for (Eigen::Index j = 0; j < mr.frequencies_hz.size(); ++j)
+    if (!mr.rigid_body[j]) {
+      f1 = mr.frequencies_hz[j];
+      break;
+    }
+  for (int k = 0; k < data.num_modes(); ++k) {
+    const Eigen::VectorXd u = data.shapes.col(k);
+    const double mac = (Q.transpose() * u).squaredNorm() / u.squaredNorm();
+    if (data.frequencies_hz[k] < 0.5 * f1 && mac >= 0.8) {
+      SetAside s;
+      s.mode = k;
+      s.frequency_hz = data.frequencies_hz[k];
+      s.reason = SetAside::Reason::kRigidBody;
+      s.mac = mac;
+      out.push_back(s);
+    }
+  }
+  return out;
+}
+
+void prepare(const Model& model, const ModalData& measured, const DiscoveryOptions& o,
+             std::vector<std::unique_ptr<Candidate>> extra, Problem* pp, DiscoverySummary* S) {
+  std::string why;
+  if (!o.IsValid(&why)) throw InputError("discover options: " + why);
+  measured.validate("measured modal data");
+  if (measured.num_modes() < 2) throw InputError("discover: at least 2 measured modes are needed");
+  measured_equations(model, measured.dofs);  // throws naming a DOF the model does not have
+  Problem& p = *pp;
+  p.model = &model;
+  p.options = o;
+  S->set_aside = rigid_body_modes(model, measured);
+
+  // The fit: frequencies and shapes, whitened at the noise model's levels; pairing never forced.
+  p.fit.objective = FitObjective::kCombined;
+  p.fit.min_mac = o.min_mac;
+  p.fit.max_frequency_ratio = o.max_frequency_ratio;
+  p.fit.max_iterations = o.max_iterations;
+  p.fit.dense_max_dofs = 40;
+
+  // Modes without a plausible partner in the model as given are not compared (never forced onto another mode).
+  std::vector<int> keep;
+  for (int k = 0; k < measured.num_modes(); ++k) {
+    bool aside = false;
+    for (const SetAside& s : S->set_aside) aside = aside || s.mode == k;
+    if (!aside) keep.push_back(k);
+  }
+  ModalData used = select_modes(measured, keep);
+  {
+    ParametricModel pm(model);
+    const Correlation c = correlate(pm, used, pm.nominal(), p.fit);
+    std::vector<int> paired;
+    for (std::size_t k = 0; k < keep.size(); ++k) {
+      if (c.model_mode[k] >= 0) {
+        paired.push_back(keep[k]);
+        continue;
+      }
+      SetAside s;
+      s.mode = keep[k];
+      s.frequency_hz = measured.frequencies_hz[keep[k]];
+      s.reason = SetAside::Reason::kNoPartner;
+      s.mac = c.mac[static_cast<Eigen::Index>(k)];
+      S->set_aside.push_back(s);
+    }
+    keep = paired;
+  }
+  std::sort(S->set_aside.begin(), S->set_aside.end(), [](const SetAside& a, const SetAside& b) { return a.mode < b.mode; });
+  p.data = select_modes(measured, keep);
+  p.modes = p.data.num_modes();
+  p.noise = noise_model(p.data, o, &S->warnings);
+  S->noise = p.noise;
+  p.fit.frequency_noise = p.noise.frequency;
+  p.fit.shape_noise = p.noise.shape;
+  std::vector<int> lone;
+  for (const SetAside& s : S->set_aside)
+    if (s.reason == SetAside::Reason::kNoPartner) lone.push_back(s.mode);
+  p.unpartnered = select_modes(measured, lone);
+  p.unpartnered_edge.resize(static_cast<Eigen::Index>(lone.size()));
+  for (std::size_t k = 0; k < lone.size(); ++k) {
+    Eigen::VectorXd u = measured.shapes.col(lone[k]);
+    u /= u.cwiseAbs().maxCoeff();
+    const double r2 = o.max_frequency_ratio * o.max_frequency_ratio;
+    const double rf = (r2 - 1) / (2 * p.noise.frequency);  // the fit's frequency residual (eigenvalue-based)
+    p.unpartnered_edge[static_cast<Eigen::Index>(k)] = rf * rf + (1 - o.min_mac) * u.squaredNorm() / (p.noise.shape * p.noise.shape);
+  }
+
+  p.context = make_context(model, p.data.num_modes() ? p.data : measured, o.sensor_nodes, o.suspension_nodes, o.gravity);
+  p.context.measured = &p.data;
+  p.context.gravity_acceleration = o.gravity_acceleration;
+  std::vector<CandidateKind> registry = builtin_candidate_kinds();
+  registry.insert(registry.end(), o.extra_kinds.begin(), o.extra_kinds.end());
+  p.library = place_candidates(p.context, registry, o.kinds);
+  for (auto& c : extra) p.library.push_back(std::move(c));
+  p.recalibration = make_recalibration(model);
+  std::set<std::string> kinds;
+  for (const auto& c : p.library) {
+    ++p.sites_per_kind[c->kind()];
+    kinds.insert(c->kind());
+  }
+  p.kinds = std::max<int>(1, static_cast<int>(kinds.size()));
+}
+
+}  // namespace dynid::internal

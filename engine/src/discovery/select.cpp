@@ -1,0 +1,299 @@
+// Discovery, stage 5: from single candidates to the explanation.
+//
+// Every start (the best single candidates that tell different stories) grows a chain: each step adds the
+// admissible candidate of best evidence, re-screened with the chain's effects fitted. Then each chain is walked:
+// an addition stays only when it is decisive and removes `further` of the misfit its predecessors leave (beyond
+// what the best explored set leaves: a real second effect removes nearly all of it, a stand-in absorbing the
+// first effect's approximation only part), and every earlier effect keeps its place beside it (backward
+// elimination). The explanation is the simplest chain result, replaced by a larger one only by the same rule;
+// the others that are about as good are its rivals.
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "discovery/stages.hpp"
+
+namespace dynid::internal {
+
+namespace {
+
+struct Search {
+  const Problem& p;
+  double chi2_0;
+  FitQuality before;
+  double scale = 1, chi2_best = 0;
+  int solves = 0;
+  std::map<std::vector<const Candidate*>, SetFit> cache;  // by the set's candidates, sorted
+
+  static std::vector<const Candidate*> key(std::vector<const Candidate*> s) {
+    std::sort(s.begin(), s.end());
+    return s;
+  }
+  const SetFit* find(const std::vector<const Candidate*>& s) const {
+    const auto it = cache.find(key(s));
+    return it == cache.end() ? nullptr : &it->second;
+  }
+  void store(const SetFit& f) {
+    solves += f.evaluations;
+    cache.emplace(key(f.set), f);
+  }
+  // Fits the sets not fitted yet (in parallel), each from its start values.
+  void fit_all(const std::vector<std::vector<const Candidate*>>& sets, const std::vector<std::vector<Eigen::VectorXd>>& starts) {
+    std::vector<int> todo;
+    for (std::size_t k = 0; k < sets.size(); ++k)
+      if (!find(sets[k])) todo.push_back(static_cast<int>(k));
+    std::vector<SetFit> out(todo.size());
+#pragma omp parallel for schedule(dynamic)
+    for (int i = 0; i < static_cast<int>(todo.size()); ++i) out[i] = fit_set(p, sets[todo[i]], starts[todo[i]]);
+    for (const SetFit& f : out)
+      if (!find(f.set)) store(f);
+  }
+  const SetFit& fitted(const std::vector<const Candidate*>& s, const std::vector<Eigen::VectorXd>& start = {}) {
+    fit_all({s}, {start});
+    return *find(s);
+  }
+
+  double evidence(const SetFit& f) const { return log_evidence(p, f, chi2_0, scale); }
+  // Share of the misfit removed, relative to the best any explored set reached (reported).
+  double explained(const SetFit& f) const {
+    const double span = chi2_0 - chi2_best;
+    return span > 0 ? std::clamp((chi2_0 - f.chi2) / span, 0.0, 1.0) : 0.0;
+  }
+  // A set that may stand as an explanation: fitted, inside its bounds, no worse than the model as given at any
+  // mode's frequency or in mean MAC, every effect significant, at most one parameter per two measured modes.
+  bool admissible(const SetFit& f) const {
+    if (!f.ok || f.at_bound) return false;
+    if (f.quality.max_freq_error_pct > before.max_freq_error_pct || f.quality.mean_mac < before.mean_mac) return false;
+    if (2 * f.parameters() > std::max(2, p.modes)) return false;
+    for (std::size_t k = 0; k < f.set.size(); ++k)
+      if (significance(f, k, scale) < p.options.min_significance) return false;
+    return true;
+  }
+  // Whether adding one effect to `from` (giving `to`) is worth it: decisive, and removing `further` of the misfit
+  // `from` leaves (beyond what the best explored set leaves).
+  bool worth(const SetFit& from, const SetFit& to) const {
+    if (!admissible(to)) return false;
+    if (evidence(to) - evidence(from) < p.options.decisive) return false;
+    return from.chi2 - to.chi2 >= p.options.further * std::max(0.0, from.chi2 - chi2_best);
+  }
+};
+
+// Whether two candidates tell the same story: same nature at neighbouring sites, or the same global kind.
+bool same_story(const Model& m, const Candidate& a, const Candidate& b) {
+  if (a.global() || b.global()) return a.kind() == b.kind();
+  if (a.nature() != b.nature() && a.nature() != Nature::kBoth && b.nature() != Nature::kBoth) return false;
+  auto nodes = [&](const Candidate& c) {
+    std::set<int> n;
+    for (int id : c.site().nodes) n.insert(id);
+    for (int id : c.site().elements) {
+      const int e = m.element_index(id);
+      for (int k = 0; k < m.elements()[e].num_nodes; ++k) n.insert(m.nodes()[m.element_nodes(e)[k]].id);
+    }
+    return n;
+  };
+  const std::set<int> na = nodes(a), nb = nodes(b);
+  for (int n : na)
+    if (nb.count(n)) return true;
+  return false;
+}
+
+// Library candidates worth adding to a fitted set: the best re-screened (the set refitted along) and the globals.
+std::vector<const Candidate*> additions(const Problem& p, const SetFit& cur) {
+  ParametricModel pm(*p.model);
+  std::vector<const Candidate*> all = cur.set;
+  std::vector<int> lib;
+  for (int k = 0; k < static_cast<int>(p.library.size()); ++k)
+    if (std::find(cur.set.begin(), cur.set.end(), p.library[k].get()) == cur.set.end()) {
+      all.push_back(p.library[k].get());
+      lib.push_back(k);
+    }
+  const std::vector<int> first = install_candidates(&pm, all);
+  Eigen::VectorXd th = pm.nominal();
+  int nc = 0;
+  for (std::size_t k = 0; k < cur.set.size(); ++k) {
+    th.segment(first[k], cur.theta[k].size()) = cur.theta[k];
+    nc += static_cast<int>(cur.theta[k].size());
+  }
+  Linearization lin;
+  try {
+    lin = linearize(pm, p.data, th, p.fit);
+  } catch (const std::exception&) {
+    return {};
+  }
+  // Drop of each candidate's magnitude column with the set's parameters refitted (projected out).
+  const Eigen::MatrixXd C = lin.J.leftCols(nc);
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(C);
+  std::vector<std::pair<double, int>> local;
+  std::vector<const Candidate*> out;
+  for (std::size_t k = 0; k < lib.size(); ++k) {
+    const Candidate* c = p.library[lib[k]].get();
+    if (c->global()) {
+      out.push_back(c);
+      continue;
+    }
+    const int col = first[cur.set.size() + k];
+    Eigen::VectorXd j = lin.J.col(col);
+    if (nc) j -= C * qr.solve(j);
+    const double h = j.squaredNorm();
+    double drop = 0;
+    if (h > 0) {
+      const Parameter& q = pm.parameter(col);
+      const double g = j.dot(lin.r), step = -g / h;
+      if (!((q.nominal <= q.lower && step < 0) || (q.nominal >= q.upper && step > 0))) drop = g * g / h;
+    }
+    local.push_back({drop, lib[k]});
+  }
+  std::stable_sort(local.begin(), local.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+  std::map<std::string, int> per;
+  for (std::size_t k = 0; k < local.size(); ++k) {
+    const Candidate* c = p.library[local[k].second].get();
+    if (static_cast<int>(k) < std::max(2, p.options.screen_fit / 2) || per[c->kind()]++ < 2) out.push_back(c);
+  }
+  return out;
+}
+
+struct ChainResult {
+  const SetFit* fit = nullptr;
+  std::vector<SelectionStep> steps;
+};
+
+SelectionStep step_of(const Search& s, SelectionStep::Action a, const std::string& what, const SetFit& f) {
+  SelectionStep st;
+  st.action = a;
+  st.description = what;
+  st.log_evidence = s.evidence(f);
+  st.explained = s.explained(f);
+  st.max_freq_error_pct = f.quality.max_freq_error_pct;
+  st.mean_mac = f.quality.mean_mac;
+  return st;
+}
+
+}  // namespace
+
+Selection select(const Problem& p, const std::vector<SetFit>& singles, double chi2_0, const FitQuality& before) {
+  Search s{p, chi2_0, before};
+  for (const SetFit& f : singles) s.cache.emplace(Search::key(f.set), f);
+  auto update_scale = [&]() {
+    s.chi2_best = chi2_0;
+    int k_best = 0;
+    for (const auto& [k, f] : s.cache)
+      if (f.ok && !f.at_bound && f.chi2 < s.chi2_best) s.chi2_best = f.chi2, k_best = f.parameters();
+    s.scale = std::sqrt(std::max(1.0, s.chi2_best / std::max(1, p.n - k_best)));
+  };
+  update_scale();
+
+  // Starts: the best admissible, decisive single candidates telling different stories.
+  std::vector<const SetFit*> ranked;
+  for (const SetFit& f : singles)
+    if (s.admissible(f) && s.evidence(f) >= p.options.decisive) ranked.push_back(s.find(f.set));
+  std::stable_sort(ranked.begin(), ranked.end(), [&](const SetFit* a, const SetFit* b) { return s.evidence(*a) > s.evidence(*b); });
+  std::vector<const SetFit*> starts;
+  for (const SetFit* f : ranked) {
+    bool fresh = true;
+    for (const SetFit* g : starts) fresh = fresh && !same_story(*p.model, *f->set[0], *g->set[0]);
+    if (fresh) starts.push_back(f);
+    if (starts.size() >= 3) break;
+  }
+
+  // Explore: grow each start greedily to max_effects (by evidence among admissible sets).
+  std::vector<std::vector<const SetFit*>> chains;
+  for (const SetFit* st : starts) {
+    std::vector<const SetFit*> chain = {st};
+    while (static_cast<int>(chain.back()->set.size()) < p.options.max_effects) {
+      const SetFit& cur = *chain.back();
+      const std::vector<const Candidate*> tries = additions(p, cur);
+      std::vector<std::vector<const Candidate*>> sets;
+      std::vector<std::vector<Eigen::VectorXd>> starts_theta;
+      for (const Candidate* c : tries) {
+        std::vector<const Candidate*> set = cur.set;
+        set.push_back(c);
+        sets.push_back(set);
+        starts_theta.push_back(cur.theta);
+      }
+      s.fit_all(sets, starts_theta);
+      const SetFit* best = nullptr;
+      for (const auto& set : sets) {
+        const SetFit* f = s.find(set);
+        if (s.admissible(*f) && (!best || s.evidence(*f) > s.evidence(*best))) best = f;
+      }
+      if (!best) break;
+      chain.push_back(best);
+    }
+    chains.push_back(chain);
+  }
+  update_scale();
+
+  // Walk each chain: each step must be worth it, and earlier effects must keep their place.
+  std::vector<ChainResult> results;
+  for (const auto& chain : chains) {
+    ChainResult r;
+    const SetFit* cur = chain[0];
+    r.steps.push_back(step_of(s, SelectionStep::Action::kStart, cur->set[0]->description(), *cur));
+    for (std::size_t j = 1; j < chain.size(); ++j) {
+      const SetFit* next = s.find(chain[j]->set);
+      if (!s.worth(*cur, *next)) break;
+      const Candidate* added = next->set.back();
+      r.steps.push_back(step_of(s, SelectionStep::Action::kAdd, added->description(), *next));
+      cur = next;
+      // Backward elimination: does each earlier effect still earn its place beside the new one?
+      bool removed = false;
+      for (const Candidate* a : std::vector<const Candidate*>(cur->set)) {
+        if (a == added) continue;
+        std::vector<const Candidate*> without;
+        std::vector<Eigen::VectorXd> start;
+        for (std::size_t k = 0; k < cur->set.size(); ++k)
+          if (cur->set[k] != a) without.push_back(cur->set[k]), start.push_back(cur->theta[k]);
+        const SetFit& w = s.fitted(without, start);
+        if (!s.worth(w, *cur) && s.admissible(w)) {
+          r.steps.push_back(step_of(s, SelectionStep::Action::kRemove, a->description(), w));
+          cur = s.find(without);
+          removed = true;
+          break;
+        }
+      }
+      if (removed) break;  // the chain's later effects were grown beside the removed one
+    }
+    r.fit = cur;
+    results.push_back(r);
+  }
+
+  Selection sel;
+  if (results.empty()) {
+    sel.chi2_best = s.chi2_best;
+    sel.scale = s.scale;
+    sel.eigen_solves = s.solves;
+    return sel;
+  }
+  // The explanation: the simplest result, replaced by a larger one only when the extra effects are worth it by
+  // the same rule as a step of a chain; among results of one size, the best evidence.
+  std::stable_sort(results.begin(), results.end(), [&](const ChainResult& a, const ChainResult& b) {
+    if (a.fit->set.size() != b.fit->set.size()) return a.fit->set.size() < b.fit->set.size();
+    return s.evidence(*a.fit) > s.evidence(*b.fit);
+  });
+  std::size_t chosen = 0;
+  for (std::size_t k = 1; k < results.size(); ++k)
+    if (results[k].fit->set.size() > results[chosen].fit->set.size() && s.worth(*results[chosen].fit, *results[k].fit)) chosen = k;
+  std::swap(results[0], results[chosen]);
+  sel.fit = *results[0].fit;
+  sel.steps = results[0].steps;
+  for (std::size_t k = 0; k < sel.fit.set.size(); ++k) {
+    if (sel.fit.set.size() == 1) {
+      sel.importance.push_back(s.evidence(sel.fit));
+      continue;
+    }
+    std::vector<const Candidate*> without;
+    std::vector<Eigen::VectorXd> start;
+    for (std::size_t j = 0; j < sel.fit.set.size(); ++j)
+      if (j != k) without.push_back(sel.fit.set[j]), start.push_back(sel.fit.theta[j]);
+    sel.importance.push_back(s.evidence(sel.fit) - s.evidence(s.fitted(without, start)));
+  }
+  for (std::size_t k = 1; k < results.size(); ++k) sel.alternatives.push_back(*results[k].fit);
+  sel.chi2_best = s.chi2_best;
+  sel.scale = s.scale;
+  sel.eigen_solves = s.solves;
+  return sel;
+}
+
+}  // namespace dynid::internal

@@ -1,0 +1,107 @@
+// The stages of discover() (internal): each a function of the Problem, tested on its own (tests/test_discovery.cpp).
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "dynid/engine/discovery.hpp"
+#include "dynid/engine/model_fit.hpp"
+
+namespace dynid::internal {
+
+/// What every stage shares: the model, the data discovery uses, the noise model, the candidates. Filled in place by
+/// prepare() (the candidate context points into it).
+struct Problem {
+  Problem() = default;
+  Problem(const Problem&) = delete;
+  Problem& operator=(const Problem&) = delete;
+  const Model* model = nullptr;
+  DiscoveryOptions options;
+  ModalData data;                  ///< the measured modes used (set-aside ones removed)
+  /// The measured modes without a partner in the model as given (a local mode of what is missing, or a spurious
+  /// identification), and per mode the chi-square it would have at the edge of plausible pairing (MAC min_mac,
+  /// frequency ratio max_frequency_ratio): a hypothesis that pairs one earns the difference.
+  ModalData unpartnered;
+  Eigen::VectorXd unpartnered_edge;
+  NoiseModel noise;
+  FitOptions fit;                  ///< combined frequency and shape residuals at the noise model's levels
+  CandidateContext context;
+  std::vector<std::unique_ptr<Candidate>> library;
+  std::unique_ptr<Candidate> recalibration;
+  std::map<std::string, int> sites_per_kind;
+  int kinds = 1;                   ///< kinds in the library (the prior of an effect's kind)
+  int n = 0;                       ///< whitened residuals
+  int modes = 0;                   ///< measured modes used
+};
+
+/// A set of candidates fitted together.
+struct SetFit {
+  bool ok = false;
+  std::vector<const Candidate*> set;
+  std::vector<Eigen::VectorXd> theta, stddev;  ///< per candidate, its own parameters
+  double chi2 = 0;                 ///< whitened residual sum of squares at the solution
+  Eigen::MatrixXd information;     ///< J^T J over the set's parameters (whitened at the stated noise)
+  FitQuality quality;
+  /// Sum over the unpartnered modes this set pairs of (edge chi-square - its chi-square): evidence from modes the
+  /// model as given lacks.
+  double unpartnered_gain = 0;
+  bool at_bound = false;           ///< a magnitude (first) parameter ended on a bound
+  int evaluations = 0;
+  int parameters() const;
+};
+
+// ---- prepare ----
+/// The noise model (stated, the data's own, or the conservative default with a warning).
+NoiseModel noise_model(const ModalData& data, const DiscoveryOptions& o, std::vector<std::string>* warnings);
+/// Free-free models: measured modes that are rigid-body motions on the test's suspension (below the first elastic
+/// model frequency, shaped like the model's rigid-body motions at the sensors).
+std::vector<SetAside> rigid_body_modes(const Model& model, const ModalData& data);
+/// Fills the problem: data without the set-aside modes, noise, candidates (throws InputError on bad options).
+void prepare(const Model& model, const ModalData& measured, const DiscoveryOptions& o,
+             std::vector<std::unique_ptr<Candidate>> extra, Problem* p, DiscoverySummary* S);
+
+// ---- locate ----
+Localization locate(const Problem& p);
+
+// ---- screen ----
+/// The linearised chi-square drop of every candidate (0 for those not screened: global ones), one eigen-solve.
+struct Screening {
+  std::vector<double> drop;        ///< per library candidate
+  Eigen::VectorXd model_hz, mac;   ///< the model as given, per measured mode
+  std::vector<char> paired;        ///< per measured mode: a plausible partner in the model as given
+  double chi2 = 0, chi2_frequency = 0;
+};
+Screening screen(const Problem& p);
+/// The local candidates to fit in full: the best screened, those at the nodes with most residual force, and
+/// every global one (library indices).
+std::vector<int> shortlist(const Problem& p, const Screening& s, const Localization& L);
+
+// ---- fit and score ----
+SetFit fit_set(const Problem& p, const std::vector<const Candidate*>& set, const std::vector<Eigen::VectorXd>& start = {});
+/// The evidence the unpartnered modes give a model with parameters theta (see SetFit::unpartnered_gain).
+double unpartnered_gain(const Problem& p, const ParametricModel& pm, const Eigen::VectorXd& theta);
+FitQuality quality_of(const Problem& p, const Eigen::VectorXd& model_hz, const Eigen::VectorXd& mac, double chi2,
+                      const std::vector<char>& nominal_paired);
+/// ln Bayes factor of a fitted set against the model as given (chi2_0), with the noise scaled by `scale`.
+double log_evidence(const Problem& p, const SetFit& f, double chi2_0, double scale);
+/// Smallest |theta - nominal| / std over the set's parameters of candidate k (std scaled by `scale`); 0 on a bound.
+double significance(const SetFit& f, std::size_t k, double scale);
+ScoredHypothesis scored(const Problem& p, const SetFit& f, std::size_t k);
+
+// ---- select ----
+/// The explanation: the smallest admissible set of effects that explains the misfit, grown from the best single
+/// candidates and pruned after every addition.
+struct Selection {
+  SetFit fit;                      ///< the chosen set (empty: nothing admissible)
+  std::vector<double> importance;  ///< per effect of `fit`: the evidence lost without it
+  std::vector<SelectionStep> steps;
+  std::vector<SetFit> alternatives;  ///< the other starts' complete explanations (rival candidates)
+  double chi2_best = 0;            ///< the lowest chi-square any explored set reached
+  double scale = 1;                ///< noise scale of the evidence
+  int eigen_solves = 0;
+};
+Selection select(const Problem& p, const std::vector<SetFit>& singles, double chi2_0, const FitQuality& before);
+
+}  // namespace dynid::internal
