@@ -3,6 +3,9 @@
 #include <chrono>
 #include <cmath>
 
+#include "dynid/engine/correlation.hpp"
+#include "dynid/mesh/generators.hpp"
+
 namespace dynid {
 
 AssembledSystem assemble_system(const ElementSource& source) {
@@ -38,6 +41,48 @@ ModalResult modal_analysis(const Model& model, const AssembledSystem& sys, const
   for (Eigen::Index k = 0; k < r.eigenvalues.size(); ++k)
     r.frequencies_hz[k] = r.rigid_body[k] ? 0.0 : eigenvalue_to_hz(r.eigenvalues[k]);
   return r;
+}
+
+Eigen::VectorXd discretization_error(const Model& model, int count) {
+  auto elastic = [](const ModalResult& r) {
+    std::vector<Eigen::Index> e;
+    for (Eigen::Index j = 0; j < r.eigenvalues.size(); ++j)
+      if (!r.rigid_body[j]) e.push_back(j);
+    return e;
+  };
+  EigenOptions eo;
+  eo.num_modes = std::min(model.num_dofs(), count + 6);
+  if (model.num_dofs() <= 400) eo.method = EigenOptions::Method::kDense;
+  const ModalResult coarse = modal_analysis(model, eo);
+  const std::vector<Eigen::Index> ec = elastic(coarse);
+  Eigen::VectorXd err = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(std::min<std::size_t>(ec.size(), static_cast<std::size_t>(count))));
+  bool members = false;
+  for (const Element& e : model.elements()) members = members || is_member(e.type);
+  if (!members || !coarse.ok()) return err;
+  const Model fine = refined(model);
+  EigenOptions ef;
+  ef.num_modes = std::min(fine.num_dofs(), count + 6 + 4);
+  if (fine.num_dofs() <= 400) ef.method = EigenOptions::Method::kDense;
+  const ModalResult rf = modal_analysis(fine, ef);
+  if (!rf.ok()) return err;
+  const std::vector<Eigen::Index> ei = elastic(rf);
+  // Both models' shapes on the model's own free DOFs (its nodes keep their ids and DOFs in the refined one).
+  std::vector<int> rows;
+  for (int n = 0; n < static_cast<int>(model.nodes().size()); ++n)
+    for (int t = 0; t < kNumDofTypes; ++t)
+      if (model.dof_map().eq(n, static_cast<Dof>(t)) >= 0) rows.push_back(fine.dof_map().eq(fine.node_index(model.nodes()[n].id), static_cast<Dof>(t)));
+  Eigen::MatrixXd A(static_cast<Eigen::Index>(rows.size()), err.size()), B(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(ei.size()));
+  for (Eigen::Index j = 0; j < err.size(); ++j) A.col(j) = coarse.modes.col(ec[static_cast<std::size_t>(j)]);
+  for (std::size_t j = 0; j < ei.size(); ++j)
+    for (std::size_t r = 0; r < rows.size(); ++r) B(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(j)) = rows[r] >= 0 ? rf.modes(rows[r], ei[j]) : 0.0;
+  const Eigen::MatrixXd mac = mac_matrix(A, B);
+  for (Eigen::Index j = 0; j < err.size(); ++j) {
+    Eigen::Index best = 0;
+    if (mac.cols() == 0 || mac.row(j).maxCoeff(&best) < 0.9) continue;
+    const double f = coarse.frequencies_hz[ec[static_cast<std::size_t>(j)]], g = rf.frequencies_hz[ei[static_cast<std::size_t>(best)]];
+    err[j] = std::abs(f - g) / f;
+  }
+  return err;
 }
 
 }  // namespace dynid

@@ -34,6 +34,9 @@ bool FitOptions::IsValid(std::string* why) const {
   };
   if (!(frequency_noise > 0)) return fail("frequency_noise must be > 0");
   if (!(shape_noise > 0)) return fail("shape_noise must be > 0");
+  for (const Eigen::VectorXd* v : {&frequency_noise_modes, &shape_noise_modes})
+    for (Eigen::Index k = 0; k < v->size(); ++k)
+      if (!((*v)[k] > 0) || !std::isfinite((*v)[k])) return fail("per-mode noise levels must be finite and > 0");
   if (!(regularization >= 0)) return fail("regularization must be >= 0");
   if (!(loss_scale > 0)) return fail("loss_scale must be > 0");
   if (max_iterations < 0) return fail("max_iterations must be >= 0");
@@ -73,6 +76,10 @@ class Evaluator {
       if (it == free_.end()) continue;  // tied to a fixed parameter: constant, handled by theta0
       xmap_[static_cast<std::size_t>(it - free_.begin())].push_back({p, t.second});
     }
+    for (const Eigen::VectorXd* v : {&o.frequency_noise_modes, &o.shape_noise_modes})
+      if (v->size() != 0 && v->size() != meas.num_modes())
+        throw InputError("fit: " + std::to_string(v->size()) + " per-mode noise levels for " + std::to_string(meas.num_modes()) +
+                         " measured modes");
     rows_ = measured_equations(pm.model(), meas.dofs);
     const Model& model = pm.model();
     for (int n = 0; n < static_cast<int>(model.nodes().size()); ++n)
@@ -83,10 +90,13 @@ class Evaluator {
     for (int p = 0; p < pm.num_parameters(); ++p)  // springs (and custom terms) may tie a free-free model down
       springs = springs || pm.parameter(p).kind == ParameterKind::kSpring || pm.parameter(p).kind == ParameterKind::kCustom;
     EigenOptions& eo = solver_.options();
-    if (model.free_free() && !springs) eo.rigid_body_basis = model.free_rigid_body_modes();
-    if (model.free_free() && springs) eo.allow_singular_stiffness = true;
+    // Free-free models: the rigid-body motions are deflated while K leaves them free; springs (and custom terms,
+    // e.g. a suspension) may tie them down at some parameters, so each solve checks (solve()).
+    if (model.free_free()) rigid_basis_ = model.free_rigid_body_modes();
+    may_tie_ = springs;
+    eo.rigid_body_basis = rigid_basis_;
     const int p = meas.num_modes();
-    const int rigid = static_cast<int>(eo.rigid_body_basis.cols());
+    const int rigid = static_cast<int>(rigid_basis_.cols());
     int want = rigid + p + o.extra_modes;
     if (o.objective == FitObjective::kSerep) want = std::max(want, static_cast<int>(rows_.size()) + rigid);
     if (n <= o.dense_max_dofs) {  // small model: every mode, dense, exact expansions
@@ -170,6 +180,15 @@ class Evaluator {
     const auto t0 = std::chrono::steady_clock::now();
     SparseMatrix K, M;
     pm_.matrices(theta, &K, &M);
+    if (may_tie_ && rigid_basis_.cols()) {
+      // Deflate the rigid-body motions only while K leaves them free (to rounding); else K - sigma M may be
+      // singular at the automatic shift, and the motions are low elastic modes on their springs.
+      Eigen::MatrixXd KR(rigid_basis_.rows(), rigid_basis_.cols());
+      for (Eigen::Index c = 0; c < rigid_basis_.cols(); ++c) symmetric_multiply(K, rigid_basis_.col(c).data(), KR.col(c).data());
+      const bool free = KR.norm() <= 1e-9 * norm1(K) * rigid_basis_.norm();
+      solver_.options().rigid_body_basis = free ? rigid_basis_ : Eigen::MatrixXd();
+      solver_.options().allow_singular_stiffness = !free;
+    }
     EigenSolution s = solver_.solve(K, M);
     // Every measured mode must be in reach of the pairing: compute modes until the highest measured frequency is
     // exceeded by 10 % (measured modes need not be the lowest ones: sensors miss local modes).
@@ -251,7 +270,11 @@ class Evaluator {
     ev_.ok = true;
   }
 
-  double sigma_lambda(int k) const { return 2.0 * o_.frequency_noise * lam_meas_[k]; }
+  double frequency_noise(int k) const {
+    return o_.frequency_noise_modes.size() == meas_.num_modes() ? o_.frequency_noise_modes[k] : o_.frequency_noise;
+  }
+  double shape_noise(int k) const { return o_.shape_noise_modes.size() == meas_.num_modes() ? o_.shape_noise_modes[k] : o_.shape_noise; }
+  double sigma_lambda(int k) const { return 2.0 * frequency_noise(k) * lam_meas_[k]; }
 
   void residuals() {
     const int p = meas_.num_modes();
@@ -263,7 +286,7 @@ class Evaluator {
         const Eigen::VectorXd x = Ps_ * U_.col(k);
         const Eigen::VectorXd r = Ps_.transpose() * ((lam_m_.array() - lam_meas_[k]).matrix().cwiseProduct(x));
         if (serep_scale_.size() != p) serep_scale_.resize(p);
-        if (!serep_scaled_) serep_scale_[k] = lam_meas_[k] * (Ps_.transpose() * (Ps_ * U_.col(k))).norm() * o_.shape_noise;
+        if (!serep_scaled_) serep_scale_[k] = lam_meas_[k] * (Ps_.transpose() * (Ps_ * U_.col(k))).norm() * shape_noise(k);
         ev_.r[k] = r / serep_scale_[k];
       }
       serep_scaled_ = true;
@@ -283,7 +306,7 @@ class Evaluator {
       const double c = U_.col(k).dot(v) / v.squaredNorm();
       ev_.r[k].resize(1 + a);
       ev_.r[k][0] = rf;
-      ev_.r[k].tail(a) = (c * v - U_.col(k)) / o_.shape_noise;
+      ev_.r[k].tail(a) = (c * v - U_.col(k)) / shape_noise(k);
     }
   }
 
@@ -354,7 +377,7 @@ class Evaluator {
         if (o_.objective == FitObjective::kCombined) {
           const Eigen::VectorXd dv = dphi[k].col(q);
           const double dc = U_.col(k).dot(dv) / vv - 2.0 * c * v.dot(dv) / vv;
-          out.tail(a) = (dc * v + c * dv) / o_.shape_noise;
+          out.tail(a) = (dc * v + c * dv) / shape_noise(k);
         }
         return out;
       };
@@ -373,6 +396,8 @@ class Evaluator {
   EigenSolver solver_;
   std::vector<int> rows_;
   std::vector<int> translations_;  // free translational equations (visibility of model modes)
+  Eigen::MatrixXd rigid_basis_;     // free-free models: the rigid-body motions
+  bool may_tie_ = false;            // springs or custom terms may tie the rigid-body motions down
   bool complete_ = false;
   Eigen::MatrixXd U_;
   Eigen::VectorXd lam_meas_;

@@ -8,6 +8,7 @@
 #include "dynid/io/test_data.hpp"
 #include "dynid/io/uff.hpp"
 #include "internal/case_util.hpp"
+#include "internal/text_util.hpp"
 #include "internal/model_yaml.hpp"
 
 namespace fs = std::filesystem;
@@ -149,6 +150,8 @@ DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model
 namespace dynid {
 
 namespace {
+using internal::format_number;
+
 ModalData keep_modes(ModalData m, const DiscoverSpec& d, std::vector<std::string>* notes) {
   std::vector<Eigen::Index> keep;
   for (Eigen::Index k = 0; k < m.frequencies_hz.size(); ++k) {
@@ -207,7 +210,19 @@ DiscoveryData discovery_data(const Case& c, int seed_offset) {
     }
     const std::string method = d.truth ? (d.method.empty() ? d.truth_test->method : d.method) : d.method;
     IdentificationOptions io = d.identify;
-    if (d.truth && io.band_hi_hz == 0) io = d.truth_test->identify;
+    if (d.truth && d.identify.band_hi_hz == 0 && d.identify.max_order == 0) io = d.truth_test->identify;
+    if (d.identify.band_hi_hz == 0 && !recs.empty()) {
+      // One rule for every case: the band the analysis model implies for these sensors (band_from_model).
+      std::vector<MeasuredDof> sensors;
+      for (const Recording& r : recs)
+        for (int ch : r.output_channels()) sensors.push_back(r.channels[static_cast<std::size_t>(ch)].dof);
+      const ModelBand b = band_from_model(c.model, sensors, recs[0].sample_rate_hz / 2);
+      io.band_lo_hz = b.lo_hz;
+      io.band_hi_hz = b.hi_hz;
+      out.notes.push_back("identification band " + format_number(b.lo_hz, 4) + " to " + format_number(b.hi_hz, 4) + " Hz, from the " +
+                          std::to_string(b.visible_hz.size()) + " lowest modes of the model the sensors see (" +
+                          format_number(b.visible_hz.front(), 4) + " to " + format_number(b.visible_hz.back(), 4) + " Hz)");
+    }
     out.identification = identify_recordings(std::move(recs), method, io);
     out.identified = true;
     out.measured = out.identification.modal_data("identified from " + out.source);

@@ -151,4 +151,43 @@ Model make_frame3d(const Frame3DSpec& s) {
   return m;
 }
 
+Model refined(const Model& model) {
+  if (!model.finalized()) throw InputError("refined: the model is not finalized");
+  Model m;
+  int next_node = 0, next_element = 0;
+  for (const Node& n : model.nodes()) next_node = std::max(next_node, n.id);
+  for (const Element& e : model.elements()) next_element = std::max(next_element, e.id);
+  for (const Node& n : model.nodes()) m.add_node(n.id, n.x);
+  for (const Material& x : model.materials()) m.add_material(x);
+  for (const Section& x : model.sections()) m.add_section(x);
+  for (int e = 0; e < model.num_elements(); ++e) {
+    const Element& el = model.elements()[e];
+    if (!is_member(el.type)) {
+      m.add_element(el);
+      continue;
+    }
+    const auto& nn = model.element_nodes(e);
+    const int mid = ++next_node;
+    m.add_node(mid, 0.5 * (model.nodes()[nn[0]].x + model.nodes()[nn[1]].x));
+    Element a = el, b = el;
+    a.node_ids = {{el.node_ids[0], mid}};
+    b.node_ids = {{mid, el.node_ids[1]}};
+    b.id = ++next_element;
+    m.add_element(a);
+    m.add_element(b);
+  }
+  // Supports: every DOF type a node has but does not number is restrained.
+  for (int n = 0; n < static_cast<int>(model.nodes().size()); ++n) {
+    DofMask r = 0;
+    for (int t = 0; t < kNumDofTypes; ++t)
+      if ((model.dof_map().active(n) & (1u << t)) && model.dof_map().eq(n, static_cast<Dof>(t)) < 0) r |= 1u << t;
+    if (r) m.restrain(model.nodes()[n].id, r);
+  }
+  m.set_mass_type(model.mass_type());
+  m.set_rotary_inertia(model.rotary_inertia());
+  m.set_free_free(model.free_free());
+  m.finalize();
+  return m;
+}
+
 }  // namespace dynid

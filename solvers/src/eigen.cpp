@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <Spectra/SymEigsSolver.h>
+#include <stdexcept>
 #include <Spectra/SymGEigsShiftSolver.h>
 
 #include <algorithm>
@@ -118,6 +119,21 @@ class TransformedOperator {
   mutable Eigen::VectorXd t_, u_;
   mutable int count_ = 0;
 };
+
+// Runs a Spectra compute(); Spectra reports a failed decomposition of its small projected matrix (e.g. a NaN from
+// an operator on a nearly singular system) by throwing std::runtime_error. That is a numerical failure of this
+// solve, returned in the summary like the others, never an exception through the caller.
+template <class F>
+bool lanczos(EigenSummary& sum, F&& compute) {
+  try {
+    compute();
+    return true;
+  } catch (const std::runtime_error& e) {
+    sum.status = EigenStatus::kNotConverged;
+    sum.message = std::string("Lanczos failed: ") + e.what() + " (the shifted system may be nearly singular; move the shift)";
+    return false;
+  }
+}
 
 // Makes the entry of largest magnitude of each column positive (ties: the first one).
 void normalize_signs(Eigen::MatrixXd* V) {
@@ -546,7 +562,8 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
         Spectra::SymEigsSolver<TransformedOperator> eigs(op, want, ncv);
         op.perform_op(x0.data(), v0.data());
         eigs.init(v0.data());
-        eigs.compute(Spectra::SortRule::LargestAlge, opt.max_restarts, opt.tolerance, Spectra::SortRule::LargestAlge);
+        if (!lanczos(sum, [&] { eigs.compute(Spectra::SortRule::LargestAlge, opt.max_restarts, opt.tolerance, Spectra::SortRule::LargestAlge); }))
+          return sol;
         sum.solves += op.count();
         sum.restarts += static_cast<int>(eigs.num_iterations());
         ok = eigs.info() == Spectra::CompInfo::Successful;
@@ -566,7 +583,8 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
         symmetric_multiply(Mu, x0.data(), b0.data());
         op.perform_op(b0.data(), v0.data());
         eigs.init(v0.data());
-        eigs.compute(selection, opt.max_restarts, opt.tolerance, Spectra::SortRule::SmallestAlge);
+        if (!lanczos(sum, [&] { eigs.compute(selection, opt.max_restarts, opt.tolerance, Spectra::SortRule::SmallestAlge); }))
+          return sol;
         sum.solves += op.count();
         sum.restarts += static_cast<int>(eigs.num_iterations());
         ok = eigs.info() == Spectra::CompInfo::Successful;

@@ -98,7 +98,7 @@ void check_set_aside(const Problem& p, const ModalData& measured, const SetFit& 
   Eigen::VectorXd th = pm.nominal();
   for (std::size_t k = 0; k < f.set.size(); ++k) th.segment(first[k], f.theta[k].size()) = f.theta[k];
   try {
-    const Correlation c = correlate(pm, d, th, p.fit);
+    const Correlation c = correlate(pm, d, th, p.fit_for_other_modes());
     std::size_t k = 0;
     for (SetAside& s : *aside) {
       if (s.reason != SetAside::Reason::kNoPartner) continue;
@@ -195,11 +195,10 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   const std::vector<int> list = shortlist(p, sc, S.localization);
   std::vector<SetFit> singles(list.size());
   SetFit recal;
-#pragma omp parallel for schedule(dynamic)
-  for (int k = 0; k <= static_cast<int>(list.size()); ++k) {
+  parallel_for(static_cast<int>(list.size()) + 1, [&](int k) {
     if (k == static_cast<int>(list.size())) recal = fit_set(p, {p.recalibration.get()});
     else singles[k] = fit_set(p, {p.library[list[k]].get()});
-  }
+  });
   for (const SetFit& f : singles) S.eigen_solves += f.evaluations;
   S.eigen_solves += recal.evaluations;
 

@@ -37,6 +37,40 @@ FitQuality quality_of(const Problem& p, const Eigen::VectorXd& model_hz, const E
   return q;
 }
 
+namespace {
+
+// A single candidate's start: its magnitude parameter scanned over a few multiples of its prior scale (both ways
+// within the bounds), each point scored by its chi-square less the evidence of the unpartnered modes it pairs.
+// A local gradient method started at the nominal value finds the basin nearest the model as given; a mass that
+// creates a local mode, or a release that reorders modes, lies in another one.
+Eigen::VectorXd scanned_start(const Problem& p, const ParametricModel& pm, const Candidate& c, int* evaluations) {
+  Eigen::VectorXd best = pm.nominal();
+  const CandidateParameter q = c.parameters()[0];
+  const double scale = q.prior_scale > 0 ? q.prior_scale : 0.1 * (q.upper - q.lower);
+  try {
+    FitProblem fp(pm, p.data, p.fit);
+    auto score = [&](const Eigen::VectorXd& th) {
+      Eigen::VectorXd r;
+      if (!fp.residuals(th, &r)) return std::numeric_limits<double>::infinity();
+      return r.squaredNorm() - unpartnered_gain(p, pm, th);
+    };
+    double best_score = score(best);
+    for (double sign : {1.0, -1.0})
+      for (double m : {0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0}) {
+        Eigen::VectorXd th = pm.nominal();
+        th[0] = q.nominal + sign * m * scale;
+        if (th[0] < q.lower || th[0] > q.upper) continue;
+        const double v = score(th);
+        if (v < best_score) best_score = v, best = th;
+      }
+    *evaluations += fp.evaluations();
+  } catch (const NumericalError&) {
+  }
+  return best;
+}
+
+}  // namespace
+
 SetFit fit_set(const Problem& p, const std::vector<const Candidate*>& set, const std::vector<Eigen::VectorXd>& start) {
   SetFit out;
   out.set = set;
@@ -45,13 +79,14 @@ SetFit fit_set(const Problem& p, const std::vector<const Candidate*>& set, const
   Eigen::VectorXd theta0 = pm.nominal();
   for (std::size_t k = 0; k < start.size() && k < set.size(); ++k)
     if (start[k].size()) theta0.segment(first[k], start[k].size()) = start[k];
+  if (set.size() == 1 && start.empty()) theta0 = scanned_start(p, pm, *set[0], &out.evaluations);
   FitSummary s;
   try {
     s = fit_parameters(pm, p.data, theta0, {}, p.fit);
   } catch (const NumericalError&) {
     return out;  // the model cannot be solved there (e.g. a release that leaves a mechanism)
   }
-  out.evaluations = s.evaluations;
+  out.evaluations += s.evaluations;
   if (!std::isfinite(s.final_cost)) return out;
   out.chi2 = 2.0 * s.final_cost;
   out.information = s.information;
@@ -72,8 +107,7 @@ SetFit fit_set(const Problem& p, const std::vector<const Candidate*>& set, const
 
 double unpartnered_gain(const Problem& p, const ParametricModel& pm, const Eigen::VectorXd& theta) {
   if (p.unpartnered.num_modes() == 0) return 0;
-  FitOptions fo = p.fit;
-  fo.objective = FitObjective::kCombined;
+  const FitOptions fo = p.fit_for_other_modes();
   double gain = 0;
   try {
     // The whitened residuals of the unpartnered modes at theta, mode by mode (a paired mode's block: its
@@ -81,7 +115,7 @@ double unpartnered_gain(const Problem& p, const ParametricModel& pm, const Eigen
     FitProblem fp(pm, p.unpartnered, fo);
     Eigen::VectorXd r;
     if (!fp.residuals(theta, &r)) return 0;
-    const Correlation c = correlate(pm, p.unpartnered, theta, p.fit);
+    const Correlation c = correlate(pm, p.unpartnered, theta, fo);
     const Eigen::Index block = 1 + static_cast<Eigen::Index>(p.unpartnered.dofs.size());
     for (int k = 0; k < p.unpartnered.num_modes(); ++k) {
       if (c.model_mode[static_cast<std::size_t>(k)] < 0) continue;

@@ -55,6 +55,7 @@ NoiseModel noise_model(const ModalData& data, const DiscoveryOptions& o, std::ve
     for (int k = 0; k < p; ++k) rel.push_back(data.frequency_std_hz[k] / data.frequencies_hz[k]);
     nm.frequency = median(rel);
     nm.frequency_source = NoiseModel::Source::kData;
+    nm.frequency_modes = Eigen::Map<const Eigen::VectorXd>(rel.data(), p).cwiseMax(nm.frequency);
   }
   if (!(nm.frequency > 0)) {
     nm.frequency = o.default_frequency_noise;
@@ -69,6 +70,7 @@ NoiseModel noise_model(const ModalData& data, const DiscoveryOptions& o, std::ve
   } else if (data.shape_std.size() == p && p > 0) {
     nm.shape = median(std::vector<double>(data.shape_std.data(), data.shape_std.data() + p));
     nm.shape_source = NoiseModel::Source::kData;
+    nm.shape_modes = data.shape_std.cwiseMax(nm.shape);
   }
   if (!(nm.shape > 0)) {
     nm.shape = o.default_shape_noise;
@@ -140,7 +142,7 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
   p.fit.dense_max_dofs = 40;
 
   // Modes without a plausible partner in the model as given are not compared (never forced onto another mode).
-  std::vector<int> keep;
+  std::vector<int> keep, partner;
   for (int k = 0; k < measured.num_modes(); ++k) {
     bool aside = false;
     for (const SetAside& s : S->set_aside) aside = aside || s.mode == k;
@@ -154,6 +156,7 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
     for (std::size_t k = 0; k < keep.size(); ++k) {
       if (c.model_mode[k] >= 0) {
         paired.push_back(keep[k]);
+        partner.push_back(c.model_mode[k]);
         continue;
       }
       SetAside s;
@@ -170,8 +173,21 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
   p.modes = p.data.num_modes();
   p.noise = noise_model(p.data, o, &S->warnings);
   S->noise = p.noise;
+  // The model's own discretisation error joins the frequency noise, mode by mode.
+  if (!partner.empty()) {
+    const Eigen::VectorXd disc = discretization_error(model, *std::max_element(partner.begin(), partner.end()) + 1);
+    p.noise.discretization.resize(p.modes);
+    for (int k = 0; k < p.modes; ++k) p.noise.discretization[k] = partner[static_cast<std::size_t>(k)] < disc.size() ? disc[partner[static_cast<std::size_t>(k)]] : 0.0;
+    if (p.noise.discretization.maxCoeff() > 0) {
+      Eigen::VectorXd f = p.noise.frequency_modes.size() ? p.noise.frequency_modes : Eigen::VectorXd::Constant(p.modes, p.noise.frequency);
+      p.noise.frequency_modes = (f.array().square() + p.noise.discretization.array().square()).sqrt();
+    }
+    S->noise = p.noise;
+  }
   p.fit.frequency_noise = p.noise.frequency;
   p.fit.shape_noise = p.noise.shape;
+  if (p.noise.frequency_modes.size()) p.fit.frequency_noise_modes = p.noise.frequency_modes;
+  if (p.noise.shape_modes.size()) p.fit.shape_noise_modes = p.noise.shape_modes;
   std::vector<int> lone;
   for (const SetAside& s : S->set_aside)
     if (s.reason == SetAside::Reason::kNoPartner) lone.push_back(s.mode);

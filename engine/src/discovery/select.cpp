@@ -19,6 +19,8 @@ namespace dynid::internal {
 
 namespace {
 
+constexpr double kMacTolerance = 1e-4;
+
 struct Search {
   const Problem& p;
   double chi2_0;
@@ -45,8 +47,7 @@ struct Search {
     for (std::size_t k = 0; k < sets.size(); ++k)
       if (!find(sets[k])) todo.push_back(static_cast<int>(k));
     std::vector<SetFit> out(todo.size());
-#pragma omp parallel for schedule(dynamic)
-    for (int i = 0; i < static_cast<int>(todo.size()); ++i) out[i] = fit_set(p, sets[todo[i]], starts[todo[i]]);
+    parallel_for(static_cast<int>(todo.size()), [&](int i) { out[i] = fit_set(p, sets[todo[i]], starts[todo[i]]); });
     for (const SetFit& f : out)
       if (!find(f.set)) store(f);
   }
@@ -61,11 +62,12 @@ struct Search {
     const double span = chi2_0 - chi2_best;
     return span > 0 ? std::clamp((chi2_0 - f.chi2) / span, 0.0, 1.0) : 0.0;
   }
-  // A set that may stand as an explanation: fitted, inside its bounds, no worse than the model as given at any
-  // mode's frequency or in mean MAC, every effect significant, at most one parameter per two measured modes.
+  // A set that may stand as an explanation: fitted, inside its bounds, no worse than the model as given in its
+  // largest frequency error or its mean MAC (to kMacTolerance: MAC differences below it are rounding, not fit),
+  // every effect significant, at most one parameter per two measured modes.
   bool admissible(const SetFit& f) const {
     if (!f.ok || f.at_bound) return false;
-    if (f.quality.max_freq_error_pct > before.max_freq_error_pct || f.quality.mean_mac < before.mean_mac) return false;
+    if (f.quality.max_freq_error_pct > before.max_freq_error_pct || f.quality.mean_mac < before.mean_mac - kMacTolerance) return false;
     if (2 * f.parameters() > std::max(2, p.modes)) return false;
     for (std::size_t k = 0; k < f.set.size(); ++k)
       if (significance(f, k, scale) < p.options.min_significance) return false;

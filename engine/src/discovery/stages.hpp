@@ -1,6 +1,8 @@
 // The stages of discover() (internal): each a function of the Problem, tested on its own (tests/test_discovery.cpp).
 #pragma once
 
+#include <algorithm>
+#include <exception>
 #include <map>
 #include <memory>
 #include <string>
@@ -10,6 +12,23 @@
 #include "dynid/engine/model_fit.hpp"
 
 namespace dynid::internal {
+
+/// fn(i) for i in [0, n), in parallel over OpenMP threads. An exception thrown by any call is rethrown after the
+/// loop (the one of the lowest i), never through OpenMP, where it would terminate the process.
+template <class F>
+void parallel_for(int n, F&& fn) {
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(std::max(n, 0)));
+#pragma omp parallel for schedule(dynamic)
+  for (int i = 0; i < n; ++i) {
+    try {
+      fn(i);
+    } catch (...) {
+      errors[static_cast<std::size_t>(i)] = std::current_exception();
+    }
+  }
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
+}
 
 /// What every stage shares: the model, the data discovery uses, the noise model, the candidates. Filled in place by
 /// prepare() (the candidate context points into it).
@@ -27,6 +46,13 @@ struct Problem {
   Eigen::VectorXd unpartnered_edge;
   NoiseModel noise;
   FitOptions fit;                  ///< combined frequency and shape residuals at the noise model's levels
+  /// The fit's options for other measured modes than `data`'s (the typical noise level instead of per mode).
+  FitOptions fit_for_other_modes() const {
+    FitOptions f = fit;
+    f.frequency_noise_modes.resize(0);
+    f.shape_noise_modes.resize(0);
+    return f;
+  }
   CandidateContext context;
   std::vector<std::unique_ptr<Candidate>> library;
   std::unique_ptr<Candidate> recalibration;

@@ -122,6 +122,12 @@ struct NoiseModel {
   enum class Source { kStated, kData, kDefault };
   double frequency = 0, shape = 0;  ///< relative std (frequencies; shape entries relative to each mode's largest)
   Source frequency_source = Source::kStated, shape_source = Source::kStated;
+  /// From the data: per measured mode (used), each at least the typical (median) mode's - a mode identified
+  /// unusually well is not trusted beyond the others, one identified poorly weighs less. Empty when stated.
+  Eigen::VectorXd frequency_modes, shape_modes;
+  /// The model's own discretisation error per measured mode used (relative frequency, discretization_error()),
+  /// added in quadrature to the frequency noise: a mesh too coarse to resolve a mode is no missing physics.
+  Eigen::VectorXd discretization;
 };
 
 /// A measured mode discovery does not use, and why.

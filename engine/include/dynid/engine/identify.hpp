@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "dynid/engine/recording.hpp"
+#include "dynid/mesh/model.hpp"
 
 namespace dynid {
 
@@ -88,6 +89,19 @@ IdentificationSummary identify_ssi(const Recording& recording, const Identificat
 /// FRF sets with the same outputs and frequency lines merged: their inputs side by side. Throws InputError if
 /// they do not match.
 FrfData merge_frfs(std::vector<FrfData> sets);
+
+/// The identification band a model implies for a test (the one rule dynid uses whenever a model is given and
+/// the band is not): the model's elastic modes the sensors can see (mean square at the sensor DOFs at least 5 %
+/// of the mode's mean square over all translations), the lowest `modes` of them (at most one per sensor DOF),
+/// band [0.6 f_first, 1.25 f_last], capped at 0.8 times the Nyquist frequency `nyquist_hz` (0 = no cap), and
+/// only modes 20 % below the cap (a mode at the band's edge is identified poorly). The margins leave room for a
+/// structure that differs from its model by tens of per cent. Throws InputError when the sensors see no mode
+/// of the model below the cap.
+struct ModelBand {
+  double lo_hz = 0, hi_hz = 0;
+  std::vector<double> visible_hz;  ///< the visible model modes the band covers
+};
+ModelBand band_from_model(const Model& model, const std::vector<MeasuredDof>& sensors, double nyquist_hz, int modes = 8);
 
 /// Recordings identified as a whole: "lscf" on H1 FRFs (recordings with force channels; a roving hammer gives one
 /// recording per hit location) or "ssi" (output-only; records of all recordings concatenated); "" picks by the

@@ -40,6 +40,13 @@ ModalResult modal_analysis(const Model& model, const EigenOptions& options);
 /// motions.
 ModalResult modal_analysis(const Model& model, const AssembledSystem& system, const EigenOptions& options);
 
+/// The discretisation error of a model's elastic frequencies, estimated by refinement: every beam and frame
+/// element split in two (refined()), the `count` lowest elastic modes of both compared, each of the model's paired
+/// with the refined model's mode of best MAC on the model's own DOFs. Per elastic mode of the model (in order):
+/// |f - f_refined| / f, about the error of f itself for cubic elements (errors fall 16-fold per halving), 0 for a
+/// mode without a partner of MAC 0.9. Models without beams or frames (matrix models) give zeros.
+Eigen::VectorXd discretization_error(const Model& model, int count);
+
 inline double eigenvalue_to_hz(double lambda) {
   return lambda > 0 ? std::sqrt(lambda) / (2.0 * 3.14159265358979323846) : 0.0;
 }

@@ -29,6 +29,9 @@ struct FitOptions {
   FitObjective objective = FitObjective::kCombined;
   double frequency_noise = 1e-3;  ///< relative std of measured frequencies
   double shape_noise = 1e-2;      ///< std of shape entries relative to each mode's largest entry
+  /// Per measured mode, when given (one value per mode): they replace frequency_noise and shape_noise for that
+  /// mode (measured uncertainties differ from mode to mode).
+  Eigen::VectorXd frequency_noise_modes, shape_noise_modes;
   double regularization = 0.0;    ///< Tikhonov weight w: residuals sqrt(w) (theta_p - nominal_p) / scale_p
   enum class Loss { kNone, kHuber, kCauchy };
   Loss loss = Loss::kNone;        ///< robust loss on each mode's frequency residual and, separately, its shape

@@ -41,6 +41,11 @@ struct Frame3DSpec {
 };
 Model make_frame3d(const Frame3DSpec& spec);
 
+/// A copy of a finalized model with every beam and frame element split in two at its midpoint (new nodes and
+/// elements numbered after the largest ids); everything else as it was: supports, point masses, springs, matrix
+/// elements, groups, factors, axial forces. Comparing the two estimates the discretisation error.
+Model refined(const Model& model);
+
 /// Number of DOFs make_frame2d / make_frame3d would produce (without building the model).
 long long frame2d_dofs(const Frame2DSpec& s);
 long long frame3d_dofs(const Frame3DSpec& s);
