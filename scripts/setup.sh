@@ -16,6 +16,7 @@ packages=(
   chromium  # scripts/check-report.sh: the report checked in a headless browser (ctest report.browser)
   clang libclang-rt-14-dev libomp-dev  # scripts/sanitize.sh, fuzz.sh: clang, libFuzzer, sanitizer run-times, OpenMP
   python3 python3-numpy python3-scipy python3-slepc4py python3-petsc4py
+  python3-matplotlib  # bench/discovery: the concealed-physics benchmark's figures
 )
 
 missing=()

@@ -1,9 +1,12 @@
 #!/usr/bin/env python3
 """Writes the discovery suite's case files (analysis models, truth models, case.yaml per case).
 
-Each truth model is meshed twice as finely as the analysis model and models its effect differently from the
-candidate that should explain it (a joint as a short soft member, not a spring; a mass spread over three nodes;
-shear deformation in finer Timoshenko elements), so that success does not rest on identical discretizations.
+Each truth model is meshed three times as finely as the analysis model and, where dynid's own elements allow,
+models its effect differently from the candidate that should explain it (a joint as a short soft member, not a
+spring; a block of mass between nodes with rotary inertia; damage over part of an element; sensors of unequal
+mass beside their nodes). Shear and preload use dynid's Timoshenko and geometric-stiffness kernels, the
+candidates' own forms (README.md says so; bench/discovery tests them against an independent continuum and an
+imposed strain). Identification uses dynid's one band rule (no band per case).
 Analysis-model nodes keep their ids in the truth model; extra truth nodes are numbered from 1000.
 Run from anywhere: python3 cases/discovery/make_cases.py (stdlib only).
 """
@@ -146,16 +149,26 @@ def link_hook(at_start, link_len, link_section):
     return hook
 
 
-def factor_hook(k_index, E_factor, div, sub):
-    """Analysis element k_index (0-based along the member) has its stiffness scaled (truth: its sub-elements)."""
+def partial_damage_hook(k_index, sub, start=0.1, end=0.9):
+    """A reduced section over [start, end] of analysis element k_index (0-based along the member), its ends away
+    from the analysis nodes: the truth re-meshes that element with nodes at those fractions."""
     def hook(m, pts, section, group):
+        a, b = pts[k_index * sub], pts[(k_index + 1) * sub]
+        (xa, ya), (xb, yb) = m.nodes[a], m.nodes[b]
         for k in range(len(pts) - 1):
-            damaged = k // sub == k_index
-            m.element(pts[k], pts[k + 1], section + "_damaged" if damaged else section, group)
+            if k // sub != k_index:
+                m.element(pts[k], pts[k + 1], section, group)
+        for x in pts[k_index * sub + 1:(k_index + 1) * sub]:   # the element's regular truth nodes are not used
+            del m.nodes[x]
+        inner = [m.extra(xa + f * (xb - xa), ya + f * (yb - ya)) for f in (start, 0.5 * (start + end), end)]
+        chain = [a] + inner + [b]
+        for k in range(len(chain) - 1):
+            m.element(chain[k], chain[k + 1], section + "_damaged" if 1 <= k <= 2 else section, group)
     return hook
 
 
-DIV = 4
+DIV = 4    # analysis elements per member
+SUB = 3    # truth elements per analysis element
 
 
 def analysis_frame():
@@ -208,7 +221,7 @@ def frame_test(sensors, seed):
       noise: 0.02
       force_noise: 0.02
       seed: {seed}
-      identify: {{method: lscf, band_hz: [2, 93]}}
+      identify: {{method: lscf}}
 """
 
 
@@ -230,7 +243,7 @@ def frame_case(folder, description, truth_mesh, truth_sections, expect, seed, no
         idx = lines.index("  defaults: {material: steel}")
         lines[idx:idx] = [f"    {k}: {v}" for k, v in truth_sections.items()]
         header = "\n".join(lines)
-    write(folder, "truth.yaml", f"# Truth model ({note}); meshed 2x finer than the analysis model.\n" + truth_mesh.yaml(header))
+    write(folder, "truth.yaml", f"# Truth model ({note}); meshed 3x finer than the analysis model.\n" + truth_mesh.yaml(header))
     sensors = frame_sensors(a)
     case = f"""# {description}
 # The analysis model never sees truth.yaml: dynid simulates an impact test on it (33 accelerometers, 2 hammer
@@ -248,11 +261,11 @@ discover:
 
 def main():
     # 1. semi-rigid beam-column joint: the first-story left beam connects to joint 4 through a 20 mm soft link
-    #    (E I_link / l = 2.0e6 N m/rad; the beam's 4 E I / L = 1.2e7).
+    #    (E I_link / l = 6.0e6 N m/rad; the beam's 4 E I / L = 1.2e7).
     k_joint = 6.0e6
     l = 0.02
     I_link = k_joint * l / 2.1e11
-    t = frame(DIV, 2, {("beam", 0, 1): link_hook(True, l, "link")})
+    t = frame(DIV, SUB, {("beam", 0, 1): link_hook(True, l, "link")})
     a = analysis_frame()
     # analysis element of the left first-story beam adjacent to joint 4
     beam_nodes = [n for n, (x, y) in a.nodes.items() if 100 <= n < 1000 and abs(y - HEIGHT) < 1e-9 and 0 < x < SPAN]
@@ -266,7 +279,7 @@ def main():
     k_base = 1.5e7
     l = 0.02
     I_stub = k_base * l / 2.1e11
-    t = frame(DIV, 2, {("column", 1, 0): link_hook(True, l, "stub")})
+    t = frame(DIV, SUB, {("column", 1, 0): link_hook(True, l, "stub")})
     col_nodes = [n for n, (x, y) in a.nodes.items() if 100 <= n < 1000 and abs(x - SPAN) < 1e-9 and 0 < y < HEIGHT]
     e_col = element_id_of(a, joint_id(1, 0), col_nodes[0])
     frame_case("frame-flexible-base", "Column base that is not fixed (concealed as a 20 mm soft stub).",
@@ -274,32 +287,39 @@ def main():
                f"{{kind: flexible_support, nodes: [{joint_id(1, 0)}], parameter: stiffness, value: {k_base}}}", 12,
                f"base of node {joint_id(1, 0)}: 20 mm stub, E I / l = {k_base:g} N m/rad")
 
-    # 3. attached mass: 120 kg at the mid-span of the second-story right beam, spread over three truth nodes.
-    t = frame(DIV, 2)
+    # 3. attached mass: a 120 kg block on the second-story right beam, centred 1/6 m beside its mid-span node
+    #    (between analysis nodes), carried by the two truth nodes under it, each with its own rotary inertia.
+    t = frame(DIV, SUB)
     mid2 = mid_node(a, 1.5 * SPAN, 2 * HEIGHT)
-    t.masses = [(mid2, 120.0, 1.6)]
-    frame_case("frame-attached-mass", "Unmodelled 120 kg block (0.4 m long, rotary inertia 1.6 kg m^2) at a beam mid-span.", t, {},
-               f"{{kind: lumped_mass, nodes: [{mid2}], parameter: mass, value: 120}}", 13, f"a 120 kg block with rotary inertia at node {mid2}")
+    beside = mid_node(t, 1.5 * SPAN + (SPAN / DIV) / SUB, 2 * HEIGHT)
+    e_mass = element_id_of(a, mid2, mid_node(a, 1.75 * SPAN, 2 * HEIGHT))
+    t.masses = [(mid2, 60.0, 0.8), (beside, 60.0, 0.8)]
+    block = (f"{{kind: [lumped_mass, element_point_mass], nodes: [{mid2}], elements: [{e_mass}], parameter: mass, "
+             f"value: 120}}")
+    frame_case("frame-attached-mass", "Unmodelled 120 kg block (rotary inertia 1.6 kg m^2) beside a beam mid-span, between nodes.",
+               t, {}, block, 13, f"a 120 kg block centred 1/6 m from node {mid2}, on two truth nodes")
 
-    # 4. element stiffness loss (the paper's damage): a first-story column element at 70 % stiffness.
-    t = frame(DIV, 2, {("beam", 0, 1): factor_hook(1, 0.5, DIV, 2)})
+    # 4. damage: half the bending stiffness lost over 0.8 m of a first-story beam, from 0.1 m into the element
+    #    next to mid-span to 0.1 m before its end. Flexibility-equivalent change of that element:
+    #    1 / (1 + d) = 1 + 0.8 (1 / 0.5 - 1)  ->  d = -44.4 %.
+    t = frame(DIV, SUB, {("beam", 0, 1): partial_damage_hook(1, SUB)})
     e_dmg = element_id_of(a, mid_node(a, 0.25 * SPAN, HEIGHT), mid_node(a, 0.5 * SPAN, HEIGHT))
-    frame_case("frame-damage", "Stiffness loss of 50 % in one element (1 m, next to mid-span) of a first-story beam.", t,
+    frame_case("frame-damage", "Half the bending stiffness lost over 0.8 m inside one element of a first-story beam.", t,
                {"beam_damaged": "{A: 3.91e-3, I: 2.895e-5}"},
-               f"{{kind: element_stiffness, elements: [{e_dmg}], parameter: stiffness change, value: -50, tolerance: 0.1}}", 14,
-               "the second quarter of the left first-story beam with I x 0.5")
+               f"{{kind: [element_stiffness, member_damage], elements: [{e_dmg}], parameter: stiffness change, value: -44.4}}", 14,
+               "a reduced section (I x 0.5) over 0.8 m of the second quarter of the left first-story beam")
 
-    # 5. two effects: flexible base (as 2) and 120 kg attached (as 3) at once.
-    t = frame(DIV, 2, {("column", 1, 0): link_hook(True, 0.02, "stub")})
-    t.masses = [(mid2, 120.0, 1.6)]
+    # 5. two effects: flexible base (as 2) and the 120 kg block (as 3) at once.
+    t = frame(DIV, SUB, {("column", 1, 0): link_hook(True, 0.02, "stub")})
+    t.masses = [(mid2, 60.0, 0.8), (beside, 60.0, 0.8)]
     frame_case("frame-two-effects", "Two effects at once: a flexible column base and an attached mass.", t,
                {"stub": f"{{A: 5.38e-3, I: {I_stub:.6g}}}"},
                f"{{kind: flexible_support, nodes: [{joint_id(1, 0)}], parameter: stiffness, value: {k_base}, "
-               f"also: [{{kind: lumped_mass, nodes: [{mid2}], parameter: mass, value: 120}}]}}", 15,
-               "flexible base of the middle column and 120 kg attached")
+               f"also: [{block}]}}", 15,
+               "flexible base of the middle column and the 120 kg block")
 
     # 6. null case: the truth is the analysis model (meshed finer); only noise separates data and model.
-    t = frame(DIV, 2)
+    t = frame(DIV, SUB)
     frame_case("frame-null", "Null case: the structure is as modelled; only measurement noise.", t, {},
                "{verdict: consistent}", 16, "identical physics")
 
@@ -327,7 +347,7 @@ def beam_mesh(L, n, support, ids_from=1, extra_sub=1):
     return m
 
 
-def beam_case(folder, description, header_a, header_t, a, t, sensors, inputs, fs, dur, band, expect, seed, note):
+def beam_case(folder, description, header_a, header_t, a, t, sensors, inputs, fs, dur, expect, seed, note):
     write(folder, "analysis.yaml", "# The beam as modelled.\n" + a.yaml(header_a))
     write(folder, "truth.yaml", f"# Truth model ({note}); meshed finer than the analysis model.\n" + t.yaml(header_t))
     case = f"""# {description}
@@ -350,7 +370,7 @@ discover:
       noise: 0.02
       force_noise: 0.02
       seed: {seed}
-      identify: {{method: lscf, band_hz: [{band[0]}, {band[1]}]}}
+      identify: {{method: lscf}}
   expect: {expect}
 """
     write(folder, "case.yaml", case)
@@ -371,36 +391,43 @@ STEEL = "E: 2.1e11, rho: 7850, nu: 0.3"
 
 
 def beams():
-    # 7. sensor mass loading: a light aluminium cantilever (600 x 25 x 3 mm, 0.12 kg) carrying five 6 g
-    #    accelerometers (with their rotary inertia in the truth).
+    # 7. sensor mass loading: a light aluminium cantilever (600 x 25 x 3 mm, 0.12 kg) carrying five
+    #    accelerometers of 4.5 to 7.5 g (6 g on average), each a third of an element beside its measured node, with
+    #    the rotary inertia of a 10 mm cube mounted on the surface.
     hdr = beam_header("alu", "E: 7.0e10, rho: 2700, nu: 0.33", 0.025, 0.003)
     a = beam_mesh(0.6, 10, "cantilever")
-    t = beam_mesh(0.6, 10, "cantilever", extra_sub=2)
+    t = beam_mesh(0.6, 10, "cantilever", extra_sub=3)
     sensors_n = [3, 5, 7, 9, 11]
-    t.masses = [(n, 0.006) for n in sensors_n]
-    beam_case("beam-sensor-mass", "Accelerometers (6 g each) loading a light cantilever.", hdr, hdr, a, t,
-              [f"{n}uy" for n in sensors_n], ["11uy"], 2048, 8, (2, 420),
-              "{kind: sensor_mass, parameter: mass per sensor, value: 0.006}", 21, "five 6 g point masses at the sensor nodes")
+    grams = [4.5, 6.0, 7.5, 5.0, 7.0]
+    beside = {n: min(x for x, (px, _) in t.nodes.items() if x >= 1000 and abs(px - (n - 1) * 0.06 + 0.02) < 1e-9)
+              for n in sensors_n}
+    t.masses = [(beside[n], g / 1000, g / 1000 * (0.01 ** 2 / 12 + 0.0065 ** 2)) for n, g in zip(sensors_n, grams)]
+    beam_case("beam-sensor-mass", "Accelerometers (4.5-7.5 g, off their nodes) loading a light cantilever.", hdr, hdr, a, t,
+              [f"{n}uy" for n in sensors_n], ["11uy"], 2048, 8,
+              "{kind: sensor_mass, parameter: mass per sensor, value: 0.006}", 21,
+              "five accelerometers of 4.5-7.5 g a third of an element inboard of the sensor nodes, with rotary inertia")
 
     # 8. shear deformation: a deep steel beam (2 m span, 400 x 100 mm, L/h = 5), simply supported; truth in
-    #    Timoshenko elements (kappa = 5/6, rotary inertia), four times finer.
+    #    Timoshenko elements (Cowper's kappa for a rectangle, 10 (1 + nu) / (12 + 11 nu) = 0.8497; rotary inertia),
+    #    three times finer.
+    kappa = 10 * 1.3 / (12 + 11 * 0.3)
     hdr = beam_header("steel", STEEL, 0.1, 0.4)
-    hdr_t = hdr.replace("s: {rectangle: {width: 0.1, depth: 0.4}}", "s: {rectangle: {width: 0.1, depth: 0.4}, shear_factor: 0.8333333333}").replace(
+    hdr_t = hdr.replace("s: {rectangle: {width: 0.1, depth: 0.4}}", f"s: {{rectangle: {{width: 0.1, depth: 0.4}}, shear_factor: {kappa:.6f}}}").replace(
         "  element: beam2d\n", "  element: beam2d\n  rotary_inertia: true\n")
     a = beam_mesh(2.0, 20, "simply_supported")
     t = beam_mesh(2.0, 20, "simply_supported", extra_sub=3)
     beam_case("deep-beam-shear", "Shear deformation and rotary inertia of a deep beam (L/h = 5) modelled as Euler-Bernoulli.", hdr, hdr_t, a, t,
-              [f"{n}uy" for n in range(3, 20, 2)], ["7uy"], 16384, 1, (100, 2400),
-              "{kind: shear_deformation, parameter: shear coefficient kappa, value: 0.8333}", 22, "Timoshenko, kappa = 5/6")
+              [f"{n}uy" for n in range(3, 20, 2)], ["7uy"], 16384, 1,
+              f"{{kind: shear_deformation, parameter: shear coefficient kappa, value: {kappa:.4f}}}", 22, "Timoshenko, Cowper's kappa")
 
     # 9. axial preload: a tensioned steel strip (2 m, 40 x 5 mm), pinned at both ends, 1 kN tension.
     hdr = beam_header("steel", STEEL, 0.04, 0.005)
     a = beam_mesh(2.0, 20, "simply_supported")
-    t = beam_mesh(2.0, 20, "simply_supported", extra_sub=2)
+    t = beam_mesh(2.0, 20, "simply_supported", extra_sub=3)
     for e in t.elements:
         e["axial_force"] = 1000.0
     beam_case("strip-preload", "A pinned steel strip under 1 kN of tension the model leaves out.", hdr, hdr, a, t,
-              [f"{n}uy" for n in range(3, 20, 2)], ["7uy"], 512, 16, (1, 120),
+              [f"{n}uy" for n in range(3, 20, 2)], ["7uy"], 512, 16,
               "{kind: axial_preload, parameter: axial force, value: 1000}", 23, "1 kN tension in every element")
 
 

@@ -577,6 +577,13 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
   out.final_hz = paired_hz(ef);
   out.final_mac = ef.mac;
   out.final_forced = ef.forced;
+  {
+    Eigen::Index n = 0;
+    for (const Eigen::VectorXd& r : ef.r) n += r.size();
+    out.final_residuals.resize(n);
+    n = 0;
+    for (const Eigen::VectorXd& r : ef.r) out.final_residuals.segment(n, r.size()) = r, n += r.size();
+  }
   for (const Eigen::VectorXd& r : ef.r) out.final_chi2_frequency += o.objective == FitObjective::kSerep ? 0.0 : r[0] * r[0];
   if (!out.converged)
     out.warnings.push_back("the fit stopped without converging (Ceres " + out.termination + " after " +

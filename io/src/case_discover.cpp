@@ -32,7 +32,10 @@ DiscoverSpec::Expect parse_expect(const YAML::Node& n, const YamlCtx& ctx, bool 
   if (e.verdict != "missing_physics" && e.verdict != "consistent" && e.verdict != "inconclusive")
     ctx.fail(n["verdict"], "expect: verdict must be missing_physics, consistent or inconclusive");
   if (e.verdict == "missing_physics" && !n["kind"]) ctx.fail(n, "expect: kind is missing (e.g. kind: semi_rigid_joint)");
-  if (n["kind"]) e.kind = ctx.string(n["kind"], "expect kind");
+  if (n["kind"] && n["kind"].IsSequence())
+    for (const auto& k : n["kind"]) e.kinds.push_back(ctx.string(k, "expect kind"));
+  else if (n["kind"])
+    e.kinds.push_back(ctx.string(n["kind"], "expect kind"));
   if (n["nodes"]) e.nodes = ints(n["nodes"], ctx, "expect nodes");
   if (n["elements"]) e.elements = ints(n["elements"], ctx, "expect elements");
   if (n["parameter"]) e.parameter = ctx.string(n["parameter"], "expect parameter");

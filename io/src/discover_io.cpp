@@ -11,16 +11,23 @@ namespace dynid {
 
 namespace {
 
-bool contains_all(const std::vector<int>& have, const std::vector<int>& want) {
+bool shares(const std::vector<int>& have, const std::vector<int>& want) {
   for (int w : want)
-    if (std::find(have.begin(), have.end(), w) == have.end()) return false;
-  return true;
+    if (std::find(have.begin(), have.end(), w) != have.end()) return true;
+  return false;
 }
 
-// Whether a finding matches one expected effect; its parameter error in *err.
+std::string kinds_words(const std::vector<std::string>& k) {
+  std::string w;
+  for (std::size_t i = 0; i < k.size(); ++i) w += (i ? " or " : "") + k[i];
+  return w;
+}
+
+// Whether a finding matches one expected effect (its kind one of the expected, its site sharing a node or an
+// element with the expected ones); its parameter error in *err.
 bool matches(const DiscoverSpec::Expect& e, const ScoredHypothesis& h, bool* kind, bool* loc, bool* par, double* err) {
-  *kind = h.kind == e.kind;
-  *loc = contains_all(h.site.nodes, e.nodes) && contains_all(h.site.elements, e.elements);
+  *kind = std::find(e.kinds.begin(), e.kinds.end(), h.kind) != e.kinds.end();
+  *loc = (e.nodes.empty() && e.elements.empty()) || shares(h.site.nodes, e.nodes) || shares(h.site.elements, e.elements);
   *par = true;
   *err = 0;
   if (!e.parameter.empty()) {
@@ -122,7 +129,15 @@ std::string fit_words(const DiscoverySummary& s) {
 
 std::string findings_words(const DiscoverySummary& s) {
   std::string w;
-  for (std::size_t k = 0; k < s.findings.size(); ++k) w += (k ? "; and " : "") + s.findings[k].finding;
+  for (std::size_t k = 0; k < s.findings.size(); ++k) {
+    const ScoredHypothesis& h = s.findings[k];
+    w += (k ? "; and " : "") + h.finding;
+    if (h.equivalent.empty()) continue;
+    w += " (the data cannot tell this site from: ";
+    for (std::size_t q = 0; q < h.equivalent.size() && q < 4; ++q) w += (q ? "; " : "") + h.equivalent[q];
+    if (h.equivalent.size() > 4) w += "; and " + std::to_string(h.equivalent.size() - 4) + " more";
+    w += ")";
+  }
   return w;
 }
 
@@ -221,7 +236,7 @@ ExpectCheck check_expectation(const DiscoverSpec::Expect& e, const DiscoverySumm
     return c;
   }
   if (s.findings.empty()) {
-    c.words = "no finding (verdict '" + verdict + "'), expected " + e.kind;
+    c.words = "no finding (verdict '" + verdict + "'), expected " + kinds_words(e.kinds);
     return c;
   }
   // With several expected effects, the first finding must be one of them (any) and each of the others must be
@@ -232,7 +247,7 @@ ExpectCheck check_expectation(const DiscoverSpec::Expect& e, const DiscoverySumm
   for (std::size_t q = 0; q < all.size(); ++q) {
     bool kk, ll, pp;
     double err;
-    if (all[q]->kind == s.findings[0].kind && matches(*all[q], s.findings[0], &kk, &ll, &pp, &err)) first = q;
+    if (matches(*all[q], s.findings[0], &kk, &ll, &pp, &err)) first = q;
   }
   matches(*all[first], s.findings[0], &c.kind, &c.location, &c.parameter, &c.parameter_error);
   for (std::size_t q = 0; q < all.size(); ++q) {
@@ -249,7 +264,7 @@ ExpectCheck check_expectation(const DiscoverSpec::Expect& e, const DiscoverySumm
     c.also = c.also && any;
   }
   c.words = std::string(c.ok() ? "as expected" : "NOT as expected") + ": first finding " + s.findings[0].kind + " at " +
-            location_words(s.findings[0].site) + (c.kind ? "" : " (expected " + e.kind + ")") +
+            location_words(s.findings[0].site) + (c.kind ? "" : " (expected " + kinds_words(all[first]->kinds) + ")") +
             (c.location ? "" : " (wrong location)") + (s.findings.size() > 1 ? " (+" + std::to_string(s.findings.size() - 1) + " more)" : "") +
             (e.parameter.empty() ? "" : ", " + e.parameter + " error " + std::to_string(100 * c.parameter_error).substr(0, 5) + " %") +
             (c.also ? "" : "; a further expected effect was not found");
@@ -275,6 +290,7 @@ nlohmann::ordered_json discovery_json(const Case& c, const DiscoveryData& d, con
     for (const PhysicalValue& v : h.values) units[v.name] = v.unit;
     f["units"] = units;
     f["description"] = h.finding;
+    f["equivalent"] = h.equivalent;
     f["importance"] = or_null(true, h.log_evidence);
     f["significance"] = h.significance;
     f["at_bound"] = h.at_bound;

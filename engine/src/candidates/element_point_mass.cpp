@@ -22,7 +22,7 @@ class ElementPointMass : public Candidate {
   Site site() const override { return {{}, {eid_}}; }
   // Mass in units of 1 % of the structure's mass (as lumped_mass); position uniform along the element.
   std::vector<CandidateParameter> parameters() const override {
-    return {{"mass", 0.0, 0.0, 100.0, 5.0}, {"position", 0.5, 0.0, 1.0, 0.0}};
+    return {{"mass", 0.0, 0.0, 100.0, 5.0, CandidateParameter::Prior::kHeavyTailed}, {"position", 0.5, 0.0, 1.0, 0.0}};
   }
   std::vector<CustomTerm> terms(const Model& m, int first) const override {
     CustomTerm t;

@@ -35,7 +35,8 @@ class EndRelease : public Candidate {
   }
   Site site() const override { return {{nid_}, {eid_}}; }
   // Flexibility in units of the member end's own flexibility 1 / K_ii: 1 = a spring as stiff as the member end.
-  std::vector<CandidateParameter> parameters() const override { return {{"flexibility", 0.0, 0.0, 100.0, 1.0}}; }
+  // Heavy-tailed prior: a connection anywhere from rigid to pinned (fixity 1 / (1 + flexibility) uniform).
+  std::vector<CandidateParameter> parameters() const override { return {{"flexibility", 0.0, 0.0, 100.0, 1.0, CandidateParameter::Prior::kHeavyTailed}}; }
 
   template <class S>
   static void condense(const Eigen::MatrixXd& B, const Eigen::MatrixXd& Mm, int i, S ct, Eigen::Matrix<S, -1, -1>* K,

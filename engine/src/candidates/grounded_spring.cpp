@@ -18,7 +18,7 @@ class GroundedSpring : public Candidate {
   }
   Site site() const override { return {{id_}, {}}; }
   // Unit: the model's own stiffness on that DOF (K_ii).
-  std::vector<CandidateParameter> parameters() const override { return {{"stiffness", 0.0, 0.0, 100.0, 1.0}}; }
+  std::vector<CandidateParameter> parameters() const override { return {{"stiffness", 0.0, 0.0, 100.0, 1.0, CandidateParameter::Prior::kHeavyTailed}}; }
   std::vector<CustomTerm> terms(const Model&, int first) const override {
     return {linear_term({eq_}, Eigen::MatrixXd::Constant(1, 1, kref_), {}, first)};
   }

@@ -44,7 +44,7 @@ class AxialPreload : public OnElements {
   std::string kind() const override { return "axial_preload"; }
   Nature nature() const override { return Nature::kStiffness; }
   std::string description() const override { return "axial preload (geometric stiffness) in " + group_words(group_); }
-  std::vector<CandidateParameter> parameters() const override { return {{"force", 0.0, -0.9, 200.0, 20.0}}; }
+  std::vector<CandidateParameter> parameters() const override { return {{"force", 0.0, -0.9, 200.0, 20.0, CandidateParameter::Prior::kHeavyTailed}}; }
   std::vector<CustomTerm> terms(const Model& m, int first) const override {
     std::vector<CustomTerm> out;
     for (int e : els_) {
@@ -81,7 +81,7 @@ class NonStructuralMass : public OnElements {
   std::string kind() const override { return "distributed_mass"; }
   Nature nature() const override { return Nature::kMass; }
   std::string description() const override { return "distributed non-structural mass on " + group_words(group_); }
-  std::vector<CandidateParameter> parameters() const override { return {{"fraction", 0.0, 0.0, 5.0, 0.5}}; }
+  std::vector<CandidateParameter> parameters() const override { return {{"fraction", 0.0, 0.0, 5.0, 0.5, CandidateParameter::Prior::kHeavyTailed}}; }
   std::vector<CustomTerm> terms(const Model& m, int first) const override {
     std::vector<CustomTerm> out;
     for (int e : els_) {

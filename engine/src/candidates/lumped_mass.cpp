@@ -16,7 +16,7 @@ class LumpedMass : public Candidate {
   std::string description() const override { return "lumped mass attached at node " + std::to_string(id_); }
   Site site() const override { return {{id_}, {}}; }
   // Unit: 1 % of the structure's mass; at most as heavy as the structure; a plausible attachment is a few per cent.
-  std::vector<CandidateParameter> parameters() const override { return {{"mass", 0.0, 0.0, 100.0, 5.0}}; }
+  std::vector<CandidateParameter> parameters() const override { return {{"mass", 0.0, 0.0, 100.0, 5.0, CandidateParameter::Prior::kHeavyTailed}}; }
   std::vector<CustomTerm> terms(const Model&, int first) const override {
     const Eigen::Index n = static_cast<Eigen::Index>(dofs_.size());
     return {linear_term(dofs_, {}, mref_ * Eigen::MatrixXd::Identity(n, n), first)};

@@ -29,8 +29,8 @@ class NodeSet : public Candidate {
   // Sensors: unit 2 % of the structure's mass shared by the sensors. Suspension: unit the stiffness that puts the
   // rigid-body modes at 1 % of the lowest measured frequency (stiffness grows as frequency squared).
   std::vector<CandidateParameter> parameters() const override {
-    if (springs_) return {{"stiffness", 0.0, 0.0, 1e4, 100.0}};
-    return {{"mass", 0.0, 0.0, 20.0, 2.0}};
+    if (springs_) return {{"stiffness", 0.0, 0.0, 1e4, 100.0, CandidateParameter::Prior::kHeavyTailed}};
+    return {{"mass", 0.0, 0.0, 20.0, 2.0, CandidateParameter::Prior::kHeavyTailed}};
   }
   std::vector<CustomTerm> terms(const Model&, int first) const override {
     std::vector<CustomTerm> out;

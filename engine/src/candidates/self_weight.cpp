@@ -23,7 +23,7 @@ class SelfWeight : public Candidate {
   std::string description() const override { return "axial forces of the structure's own weight (geometric stiffness under gravity)"; }
   Site site() const override { return site_; }
   bool global() const override { return true; }
-  std::vector<CandidateParameter> parameters() const override { return {{"load factor", 0.0, 0.0, 200.0, 5.0}}; }
+  std::vector<CandidateParameter> parameters() const override { return {{"load factor", 0.0, 0.0, 200.0, 5.0, CandidateParameter::Prior::kHeavyTailed}}; }
   std::vector<CustomTerm> terms(const Model& m, int first) const override {
     std::vector<CustomTerm> out;
     for (std::size_t k = 0; k < els_.size(); ++k) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <numeric>
 
 #include "candidates/registry.hpp"
@@ -109,37 +110,6 @@ void check_set_aside(const Problem& p, const ModalData& measured, const SetFit& 
     }
   } catch (const NumericalError&) {
   }
-}
-
-// Whether two sets of effects tell different stories (an effect of one is unlike every effect of the other).
-bool different(const Model& m, const std::vector<const Candidate*>& a, const std::vector<const Candidate*>& b) {
-  auto like = [&](const Candidate* x, const std::vector<const Candidate*>& set) {
-    for (const Candidate* y : set) {
-      if (x->global() || y->global()) {
-        if (x->kind() == y->kind()) return true;
-        continue;
-      }
-      const Site sx = x->site(), sy = y->site();
-      std::vector<int> nx = sx.nodes, ny = sy.nodes;
-      for (int id : sx.elements) {
-        const int e = m.element_index(id);
-        for (int k = 0; k < m.elements()[e].num_nodes; ++k) nx.push_back(m.nodes()[m.element_nodes(e)[k]].id);
-      }
-      for (int id : sy.elements) {
-        const int e = m.element_index(id);
-        for (int k = 0; k < m.elements()[e].num_nodes; ++k) ny.push_back(m.nodes()[m.element_nodes(e)[k]].id);
-      }
-      const bool near = std::find_first_of(nx.begin(), nx.end(), ny.begin(), ny.end()) != nx.end();
-      const bool nature = x->nature() == y->nature() || x->nature() == Nature::kBoth || y->nature() == Nature::kBoth;
-      if (near && nature) return true;
-    }
-    return false;
-  };
-  for (const Candidate* x : a)
-    if (!like(x, b)) return true;
-  for (const Candidate* y : b)
-    if (!like(y, a)) return true;
-  return false;
 }
 
 }  // namespace
@@ -266,11 +236,49 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   S.after = sel.fit.quality;
   check_set_aside(p, measured, sel.fit, &S.set_aside);
 
+  // Equivalent sites: candidates of a finding's kind elsewhere whose single fits predict the same data (their
+  // whitened predictions differ by less than the data resolve, 2 x ambiguity in chi-square at the evidence's
+  // noise) with about the same evidence. The data cannot tell them apart (a spring anywhere along an axially
+  // rigid floor beam): the finding names them all, its own site first.
+  const double s2 = sel.scale * sel.scale;
+  std::map<const Candidate*, std::vector<const Candidate*>> equivalent;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const Candidate* c = sel.fit.set[order[k]];
+    const auto own = std::find_if(singles.begin(), singles.end(), [&](const SetFit& f) { return f.ok && f.set[0] == c; });
+    if (own == singles.end()) continue;
+    const double le = log_evidence(p, *own, chi2_0, sel.scale);
+    for (const SetFit& g : singles) {
+      if (!g.ok || g.at_bound || g.set[0] == c || g.set[0]->kind() != c->kind()) continue;
+      if (log_evidence(p, g, chi2_0, sel.scale) < le - options.ambiguity) continue;
+      if ((g.residuals - own->residuals).squaredNorm() / s2 > 2 * options.ambiguity) continue;
+      equivalent[c].push_back(g.set[0]);
+      ScoredHypothesis& h = S.findings[k];
+      for (int id : g.set[0]->site().nodes)
+        if (std::find(h.site.nodes.begin(), h.site.nodes.end(), id) == h.site.nodes.end()) h.site.nodes.push_back(id);
+      for (int id : g.set[0]->site().elements)
+        if (std::find(h.site.elements.begin(), h.site.elements.end(), id) == h.site.elements.end()) h.site.elements.push_back(id);
+      h.equivalent.push_back(g.set[0]->description());
+    }
+  }
+  // Whether a set of effects tells another story than the findings: an effect unlike every finding.
+  auto like = [&](const Candidate* x, const Candidate* f) {
+    if (x == f || same_story(model, *x, *f)) return true;
+    const auto it = equivalent.find(f);
+    return it != equivalent.end() && std::find(it->second.begin(), it->second.end(), x) != it->second.end();
+  };
+  auto other_story = [&](const std::vector<const Candidate*>& a) {
+    for (const Candidate* x : a)
+      if (std::none_of(sel.fit.set.begin(), sel.fit.set.end(), [&](const Candidate* f) { return like(x, f); })) return true;
+    for (const Candidate* f : sel.fit.set)
+      if (std::none_of(a.begin(), a.end(), [&](const Candidate* x) { return like(x, f); })) return true;
+    return false;
+  };
+
   // Rivals: complete explanations of other stories, and the recalibration, within `ambiguity` in evidence.
   const double best = S.combined.log_evidence;
   for (const SetFit& a : sel.alternatives) {
     if (a.set.size() > sel.fit.set.size()) continue;
-    if (log_evidence(p, a, chi2_0, sel.scale) < best - options.ambiguity || !different(model, a.set, sel.fit.set)) continue;
+    if (log_evidence(p, a, chi2_0, sel.scale) < best - options.ambiguity || !other_story(a.set)) continue;
     ScoredHypothesis h = score(a, 0);
     h.kind.clear();
     h.description.clear();

@@ -2,6 +2,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <limits>
+#include <set>
 
 #include "discovery/stages.hpp"
 #include "dynid/mesh/error.hpp"
@@ -89,6 +90,7 @@ SetFit fit_set(const Problem& p, const std::vector<const Candidate*>& set, const
   out.evaluations += s.evaluations;
   if (!std::isfinite(s.final_cost)) return out;
   out.chi2 = 2.0 * s.final_cost;
+  out.residuals = s.final_residuals;
   out.information = s.information;
   out.quality = quality_of(p, s.final_hz, s.final_mac, out.chi2, s.final_forced);
   for (std::size_t k = 0; k < set.size(); ++k) {
@@ -132,9 +134,10 @@ namespace {
 
 double normal_cdf(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
 
-// ln of the prior density of one parameter at theta, and its precision (the Laplace approximation's prior term).
-// A normal of std tau around the nominal, truncated to the bounds; tau = 0: uniform on the bounds, whose precision
-// is taken as that of a normal of equal variance (12 / width^2).
+// ln of the prior density of one parameter at theta, and its precision (the Laplace approximation's prior term),
+// truncated to the bounds (candidate.hpp). Normal: precision 1 / tau^2. Heavy-tailed: its curvature is negative
+// away from the nominal, so it adds no precision (the data's information alone sets the posterior width). Uniform:
+// precision that of a normal of equal variance (12 / width^2), so that an undetermined parameter stays bounded.
 void prior(const CandidateParameter& q, double theta, double* log_density, double* precision) {
   const double w = q.upper - q.lower;
   if (!(q.prior_scale > 0)) {
@@ -143,6 +146,16 @@ void prior(const CandidateParameter& q, double theta, double* log_density, doubl
     return;
   }
   const double t = q.prior_scale;
+  if (q.prior == CandidateParameter::Prior::kHeavyTailed) {
+    // Density (1/t) / (1 + |x - x0| / t)^2 on each side of x0 (half the mass each), truncated: the mass on
+    // [x0, x0 + d] is (1/2) (1 - 1 / (1 + d / t)).
+    auto side = [&](double d) { return d > 0 ? 0.5 * (1.0 - 1.0 / (1.0 + d / t)) : 0.0; };
+    const double mass = side(q.upper - q.nominal) + side(q.nominal - q.lower);
+    const double z = std::abs(theta - q.nominal) / t;
+    *log_density = std::log(0.5 / t) - 2.0 * std::log1p(z) - std::log(std::max(mass, 1e-300));
+    *precision = 0.0;
+    return;
+  }
   const double mass = normal_cdf((q.upper - q.nominal) / t) - normal_cdf((q.lower - q.nominal) / t);
   const double z = (theta - q.nominal) / t;
   *log_density = -0.5 * z * z - std::log(t * std::sqrt(2 * M_PI)) - std::log(std::max(mass, 1e-300));
@@ -209,6 +222,24 @@ ScoredHypothesis scored(const Problem& p, const SetFit& f, std::size_t k) {
   h.mean_mac = f.quality.mean_mac;
   h.at_bound = f.at_bound;
   return h;
+}
+
+bool same_story(const Model& m, const Candidate& a, const Candidate& b) {
+  if (a.global() || b.global()) return a.kind() == b.kind();
+  if (a.nature() != b.nature() && a.nature() != Nature::kBoth && b.nature() != Nature::kBoth) return false;
+  auto nodes = [&](const Candidate& c) {
+    const Site site = c.site();
+    std::set<int> n(site.nodes.begin(), site.nodes.end());
+    for (int id : site.elements) {
+      const int e = m.element_index(id);
+      for (int k = 0; k < m.elements()[e].num_nodes; ++k) n.insert(m.nodes()[m.element_nodes(e)[k]].id);
+    }
+    return n;
+  };
+  const std::set<int> na = nodes(a), nb = nodes(b);
+  for (int n : na)
+    if (nb.count(n)) return true;
+  return false;
 }
 
 }  // namespace dynid::internal

@@ -193,12 +193,19 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
     if (s.reason == SetAside::Reason::kNoPartner) lone.push_back(s.mode);
   p.unpartnered = select_modes(measured, lone);
   p.unpartnered_edge.resize(static_cast<Eigen::Index>(lone.size()));
+  // A mode no model mode pairs has, under the model, only a vague density: uniform over the plausible range of
+  // its whitened residuals (frequency ratio within max_frequency_ratio, each shape entry within +-1 of the
+  // largest). Pairing it with a residual vector r replaces that density by the noise's normal one: the gain in
+  // -2 ln L is sum over entries of 2 ln(width / sqrt(2 pi)) - |r|^2, bounded by the "edge" below. (A chi-square
+  // edge, as before, grew with the inverse square of the noise and let one set-aside mode outweigh every
+  // paired one.)
   for (std::size_t k = 0; k < lone.size(); ++k) {
-    Eigen::VectorXd u = measured.shapes.col(lone[k]);
-    u /= u.cwiseAbs().maxCoeff();
     const double r2 = o.max_frequency_ratio * o.max_frequency_ratio;
-    const double rf = (r2 - 1) / (2 * p.noise.frequency);  // the fit's frequency residual (eigenvalue-based)
-    p.unpartnered_edge[static_cast<Eigen::Index>(k)] = rf * rf + (1 - o.min_mac) * u.squaredNorm() / (p.noise.shape * p.noise.shape);
+    const double wf = (r2 - 1.0 / r2) / (2 * p.noise.frequency);  // width of the frequency residual (eigenvalue-based)
+    const double ws = 2.0 / p.noise.shape;                          // width of a shape entry's residual
+    const double per = [](double w) { return std::max(0.0, 2.0 * std::log(w / std::sqrt(2 * M_PI))); }(ws);
+    p.unpartnered_edge[static_cast<Eigen::Index>(k)] =
+        std::max(0.0, 2.0 * std::log(wf / std::sqrt(2 * M_PI))) + per * static_cast<double>(measured.dofs.size());
   }
 
   p.context = make_context(model, p.data.num_modes() ? p.data : measured, o.sensor_nodes, o.suspension_nodes, o.gravity);

@@ -82,25 +82,6 @@ struct Search {
   }
 };
 
-// Whether two candidates tell the same story: same nature at neighbouring sites, or the same global kind.
-bool same_story(const Model& m, const Candidate& a, const Candidate& b) {
-  if (a.global() || b.global()) return a.kind() == b.kind();
-  if (a.nature() != b.nature() && a.nature() != Nature::kBoth && b.nature() != Nature::kBoth) return false;
-  auto nodes = [&](const Candidate& c) {
-    std::set<int> n;
-    for (int id : c.site().nodes) n.insert(id);
-    for (int id : c.site().elements) {
-      const int e = m.element_index(id);
-      for (int k = 0; k < m.elements()[e].num_nodes; ++k) n.insert(m.nodes()[m.element_nodes(e)[k]].id);
-    }
-    return n;
-  };
-  const std::set<int> na = nodes(a), nb = nodes(b);
-  for (int n : na)
-    if (nb.count(n)) return true;
-  return false;
-}
-
 // Library candidates worth adding to a fitted set: the best re-screened (the set refitted along) and the globals.
 std::vector<const Candidate*> additions(const Problem& p, const SetFit& cur) {
   ParametricModel pm(*p.model);

@@ -40,8 +40,8 @@ struct Problem {
   DiscoveryOptions options;
   ModalData data;                  ///< the measured modes used (set-aside ones removed)
   /// The measured modes without a partner in the model as given (a local mode of what is missing, or a spurious
-  /// identification), and per mode the chi-square it would have at the edge of plausible pairing (MAC min_mac,
-  /// frequency ratio max_frequency_ratio): a hypothesis that pairs one earns the difference.
+  /// identification), and per mode the most a hypothesis pairing it can gain in -2 ln L: the log ratio of the noise's
+  /// normal density to the vague density an unpaired mode has (prepare.cpp); it earns that less its chi-square.
   ModalData unpartnered;
   Eigen::VectorXd unpartnered_edge;
   NoiseModel noise;
@@ -68,6 +68,7 @@ struct SetFit {
   std::vector<const Candidate*> set;
   std::vector<Eigen::VectorXd> theta, stddev;  ///< per candidate, its own parameters
   double chi2 = 0;                 ///< whitened residual sum of squares at the solution
+  Eigen::VectorXd residuals;       ///< the whitened residuals at the solution (what the set predicts, less the data)
   Eigen::MatrixXd information;     ///< J^T J over the set's parameters (whitened at the stated noise)
   FitQuality quality;
   /// Sum over the unpartnered modes this set pairs of (edge chi-square - its chi-square): evidence from modes the
@@ -115,6 +116,9 @@ double log_evidence(const Problem& p, const SetFit& f, double chi2_0, double sca
 /// Smallest |theta - nominal| / std over the set's parameters of candidate k (std scaled by `scale`); 0 on a bound.
 double significance(const SetFit& f, std::size_t k, double scale);
 ScoredHypothesis scored(const Problem& p, const SetFit& f, std::size_t k);
+/// Whether two candidates tell the same story: the same global kind, or local ones of compatible nature (mass
+/// with mass, stiffness with stiffness; "both" with either) at sites that share a node.
+bool same_story(const Model& m, const Candidate& a, const Candidate& b);
 
 // ---- select ----
 /// The explanation: the smallest admissible set of effects that explains the misfit, grown from the best single

@@ -26,14 +26,20 @@ struct Site {
   std::vector<int> nodes, elements;
 };
 
-/// One parameter of a candidate, in the candidate's own dimensionless units (well scaled for the optimiser).
-/// Its prior is a normal distribution centred on `nominal` with standard deviation `prior_scale` (the physically
-/// plausible magnitude of the effect), truncated to [lower, upper]; prior_scale = 0 means uniform on the bounds.
-/// Discovery's evidence weighs the prior's width against the posterior's (the Occam factor).
+/// One parameter of a candidate, in the candidate's own dimensionless units (well scaled for the optimiser). The
+/// first parameter is the effect's magnitude (zero effect at its nominal value); others (a position) follow.
+/// Its prior, truncated to [lower, upper], is centred on `nominal` with `prior_scale` the physically plausible
+/// magnitude of the effect: a normal of that standard deviation (a property that changes by a fraction), or,
+/// heavy-tailed, the density (1/s) / (1 + |x - nominal| / s)^2 with median s (a stiffness, a flexibility, a mass, a
+/// force that may lie anywhere over orders of magnitude: a joint from rigid to pinned has fixity factor
+/// 1 / (1 + x / s) uniform on [0, 1]); prior_scale = 0 means uniform on the bounds. Discovery's evidence weighs
+/// the prior's width against the posterior's (the Occam factor).
 struct CandidateParameter {
+  enum class Prior { kNormal, kHeavyTailed };
   std::string name;
   double nominal = 0, lower = 0, upper = 1;
   double prior_scale = 1;
+  Prior prior = Prior::kNormal;
 };
 
 /// A parameter in physical units (what the report states).

@@ -103,6 +103,9 @@ struct ScoredHypothesis {
   double significance = 0;         ///< smallest |theta - nominal| / std over its parameters
   std::vector<PhysicalValue> values;
   std::string finding;             ///< the candidate's own sentence (Candidate::finding)
+  /// Findings: the same kind at other sites the data cannot tell from this one (their sites are in `site` too,
+  /// after its own).
+  std::vector<std::string> equivalent;
   double max_freq_error_pct = 0, mean_mac = 0;
   bool at_bound = false;           ///< a parameter ended on a bound (the hypothesis strains to fit)
 };

@@ -84,6 +84,7 @@ struct FitSummary {
   /// inverse posterior covariance at the stated noise (Laplace approximations of the evidence).
   Eigen::MatrixXd information;
   double final_chi2_frequency = 0;  ///< the frequency residuals' part of 2 final_cost
+  Eigen::VectorXd final_residuals;  ///< the whitened residuals at the solution, mode by mode (as linearize())
   std::vector<char> final_forced;   ///< per measured mode: paired below min_mac (or the ratio bound) at the solution
   std::vector<int> at_bound;    ///< parameters that ended on a bound
   std::vector<std::string> warnings;

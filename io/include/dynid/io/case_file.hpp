@@ -87,8 +87,8 @@ struct DiscoverSpec {
   DiscoveryOptions options;
   int seeds = 1;                           ///< robustness study: repeat the truth test with this many seeds
   struct Expect {
-    std::string kind;
-    std::vector<int> nodes, elements;      ///< the finding's site must contain these (either list may be empty)
+    std::vector<std::string> kinds;        ///< the finding's kind must be one of these (`kind: a` or `kind: [a, b]`)
+    std::vector<int> nodes, elements;      ///< the finding's site must share a node or an element with these
     std::string parameter;                 ///< physical value checked (name as reported)
     double value = 0;
     double tolerance = 0.10;               ///< relative
