@@ -25,6 +25,15 @@ void ModalData::validate(const std::string& what) const {
   optional(mpc, "MPC");
   optional(frequency_std_hz, "frequency standard deviation");
   optional(damping_std, "damping standard deviation");
+  optional(shape_std, "shape standard deviation");
+  auto non_negative = [&](const Eigen::VectorXd& v, const char* name) {
+    for (Eigen::Index k = 0; k < v.size(); ++k)
+      if (!std::isfinite(v[k]) || v[k] < 0)
+        throw InputError(what + ": mode " + std::to_string(k + 1) + " has " + name + " " + std::to_string(v[k]) +
+                         "; standard deviations must be finite and >= 0");
+  };
+  non_negative(frequency_std_hz, "frequency standard deviation");
+  non_negative(shape_std, "shape standard deviation");
   for (Eigen::Index k = 0; k < m; ++k) {
     if (!std::isfinite(frequencies_hz[k]) || frequencies_hz[k] <= 0)
       throw InputError(what + ": mode " + std::to_string(k + 1) + " has frequency " + std::to_string(frequencies_hz[k]) +

@@ -27,6 +27,8 @@ struct ModalData {
   Eigen::VectorXd mpc;             ///< optional modal phase collinearity of identified modes (1 = real mode)
   Eigen::VectorXd frequency_std_hz;  ///< optional standard deviation of each frequency (identification)
   Eigen::VectorXd damping_std;       ///< optional standard deviation of each damping ratio
+  /// Optional standard deviation of each mode's shape entries, relative to the mode's largest entry.
+  Eigen::VectorXd shape_std;
   std::string source;              ///< where it came from (file, "simulation of ...")
   int num_modes() const { return static_cast<int>(frequencies_hz.size()); }
   /// Throws InputError if sizes disagree or values are not finite / frequencies not positive.
