@@ -76,6 +76,36 @@ Eigen::MatrixXcd lsfd(const Eigen::VectorXd& w, const Eigen::MatrixXcd& H, const
   return R;
 }
 
+// Residues of every FRF column at one pole from the lines around it alone (a local LSFD: the pole's pair and a
+// complex constant plus slope for everything else). For judging a cluster: near-duplicate poles of one mode do
+// not share (and scramble) one residue as they would in a joint fit. Returns one residue per column.
+Eigen::VectorXcd local_residues(const Eigen::VectorXd& w, const Eigen::MatrixXcd& H, std::complex<double> pole, double half_width) {
+  const Eigen::Index nf = w.size();
+  const double wr = pole.imag();
+  Eigen::Index a = std::lower_bound(w.data(), w.data() + nf, wr - half_width) - w.data();
+  Eigen::Index b = std::upper_bound(w.data(), w.data() + nf, wr + half_width) - w.data();
+  while (b - a < 8 && (a > 0 || b < nf)) {
+    if (a > 0) --a;
+    if (b < nf) ++b;
+  }
+  const Eigen::Index n = b - a;
+  const std::complex<double> I(0, 1);
+  Eigen::MatrixXcd B(n, 6);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const std::complex<double> sk = I * w[a + k], p = 1.0 / (sk - pole), q = 1.0 / (sk - std::conj(pole));
+    const double x = (w[a + k] - wr) / std::max(half_width, 1e-300);
+    B.row(k) << p + q, I * p - I * q, 1.0, I, x, I * x;
+  }
+  Eigen::MatrixXd A(2 * n, 6), rhs(2 * n, H.cols());
+  A << B.real(), B.imag();
+  rhs << H.middleRows(a, n).real(), H.middleRows(a, n).imag();
+  const Eigen::VectorXd scale = A.colwise().norm().cwiseMax(1e-300).cwiseInverse();
+  const Eigen::MatrixXd x = (A * scale.asDiagonal()).colPivHouseholderQr().solve(rhs);
+  Eigen::VectorXcd R(H.cols());
+  for (Eigen::Index c = 0; c < H.cols(); ++c) R[c] = {scale[0] * x(0, c), scale[1] * x(1, c)};
+  return R;
+}
+
 // The k leading left singular vectors and values of a square matrix. Large matrices: randomized range finder
 // with a fixed seed and 4 subspace (power) iterations, then an exact SVD of the small projected matrix; the
 // signal subspace of a correlation Toeplitz matrix is separated by a wide gap, which this resolves to working
@@ -352,22 +382,21 @@ IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationO
   };
   std::vector<Candidate> cands(clusters.size());
   std::vector<double> peak(clusters.size(), 0.0);
-  std::vector<std::complex<double>> shaped;
-  std::vector<std::size_t> shaped_of;
   for (std::size_t c = 0; c < clusters.size(); ++c) {
     cands[c].cluster = clusters[c];
     cands[c].strength = clusters[c].support;
-    if (clusters[c].support >= o.min_cluster_fraction) {
-      shaped.push_back(internal::pole_of(clusters[c].frequency_hz, clusters[c].damping_ratio) - frf.window_decay);
-      shaped_of.push_back(c);
-    }
     // The windowed data's peaks are wider by the window's decay.
     const double zw = clusters[c].damping_ratio + frf.window_decay / (2 * kPi * clusters[c].frequency_hz);
     peak[c] = internal::indicator_peakness(s.frequency_hz, s.background.cwiseAbs2(), clusters[c].frequency_hz, zw);
+    if (clusters[c].support < internal::kShapedShare * o.min_cluster_fraction) continue;
+    const std::complex<double> pw = internal::pole_of(clusters[c].frequency_hz, clusters[c].damping_ratio) - frf.window_decay;
+    const Eigen::VectorXcd R = local_residues(w, H, pw, std::max(3 * zw * std::abs(pw), 5 * 2 * kPi * s.resolution_hz));
+    Eigen::MatrixXcd Rr(no, ni);
+    for (int i = 0; i < ni; ++i)
+      for (int oo = 0; oo < no; ++oo) Rr(oo, i) = R[oo + i * no];
+    cands[c].shape = principal(Rr);
   }
-  const std::vector<Eigen::MatrixXcd> first = residues(shaped);
-  for (std::size_t k = 0; k < shaped_of.size(); ++k) cands[shaped_of[k]].shape = principal(first[k]);
-  internal::make_modes(cands, peak, internal::check_evidence(cands, peak, o, s), s);
+  internal::make_modes(cands, peak, internal::check_evidence(cands, peak, o, orders.size(), s), orders.size(), s);
   if (!s.modes.empty()) {
     // LSFD at the modes' poles of the windowed data (the window's decay put back).
     std::vector<std::complex<double>> poles;
@@ -494,6 +523,8 @@ IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOpt
     const PoleCluster& pc = clusters[c];
     cands[c].cluster = pc;
     cands[c].strength = pc.support;
+    peak[c] = internal::indicator_peakness(s.frequency_hz, s.background, pc.frequency_hz, pc.damping_ratio);
+    if (pc.support < internal::kShapedShare * o.min_cluster_fraction) continue;
     const std::size_t top = static_cast<std::size_t>(std::max_element(pc.member_weight.begin(), pc.member_weight.end()) - pc.member_weight.begin());
     const Eigen::VectorXcd ref = orders[pc.members[top].first][pc.members[top].second].vec.normalized();
     Eigen::VectorXcd sum = Eigen::VectorXcd::Zero(ref.size());
@@ -504,9 +535,8 @@ IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOpt
       sum += pc.member_weight[m] * v;
     }
     cands[c].shape = sum;
-    peak[c] = internal::indicator_peakness(s.frequency_hz, s.background, pc.frequency_hz, pc.damping_ratio);
   }
-  internal::make_modes(cands, peak, internal::check_evidence(cands, peak, o, s), s);
+  internal::make_modes(cands, peak, internal::check_evidence(cands, peak, o, orders.size(), s), orders.size(), s);
   for (IdentifiedMode& m : s.modes) finish_shape(m);
   mark_twins(s.modes, false);
   s.background_label = "first singular value of the output spectral matrix";

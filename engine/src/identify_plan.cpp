@@ -1,5 +1,6 @@
 // The band and frequency resolution of an identification from the data's spectral peaks (see
 // dynid/engine/identify.hpp, plan_identification).
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 
@@ -87,6 +88,45 @@ double half_power_width(const Spectrum& sp, double f) {
   return cross(b, b - 1) - cross(a, a + 1);
 }
 
+// Peaks of a spectrum (power-like levels) that stand >= 10 dB above their surroundings and above the 10th
+// percentile of the levels up to `top`, ascending.
+std::vector<double> band_peaks(const Spectrum& q, double top, std::vector<double>* widths);
+
+// The band rule (identify.hpp): [0.5 x lowest peak, min(1.25 x highest, top)].
+void band_from_peaks(IdentificationPlan& p, double top) {
+  if (p.peaks_hz.empty()) {
+    p.band_lo_hz = 0;
+    p.band_hi_hz = top;
+    p.notes.push_back("no spectral peak stands 10 dB above its surroundings and the noise floor: the whole band up to " + std::to_string(top) + " Hz");
+    return;
+  }
+  p.band_lo_hz = 0.5 * p.peaks_hz.front();
+  p.band_hi_hz = std::min(1.25 * p.peaks_hz.back(), top);
+  p.band_from_data = true;
+  char b[200];
+  std::snprintf(b, sizeof b, "band %.4g-%.4g Hz from %zu spectral peaks (%.4g to %.4g Hz): 0.5 x the lowest, 1.25 x the highest", p.band_lo_hz,
+                p.band_hi_hz, p.peaks_hz.size(), p.peaks_hz.front(), p.peaks_hz.back());
+  p.notes.push_back(b);
+}
+
+std::vector<double> band_peaks(const Spectrum& q, double top, std::vector<double>* widths) {
+  Eigen::VectorXd db(q.level.size());
+  for (Eigen::Index k = 0; k < db.size(); ++k) db[k] = 10 * std::log10(std::max(q.level[k], 1e-300));
+  std::vector<double> in_band;
+  for (Eigen::Index k = 1; k < db.size(); ++k)
+    if (q.f[k] <= top) in_band.push_back(db[k]);
+  const double floor = percentile(in_band, 0.1);
+  std::vector<double> out;
+  for (const SpectrumPeak& pk : spectrum_peaks(q.f, db, q.f[0] + q.df * 0.5, top, 10.0))
+    if (pk.level_db >= floor + 10) out.push_back(pk.frequency_hz);
+  std::sort(out.begin(), out.end());
+  if (widths) {
+    widths->clear();
+    for (double f : out) widths->push_back(half_power_width(q, f));
+  }
+  return out;
+}
+
 int pow2_at_most(double n) {
   int p = 8;
   while (2.0 * p <= n) p *= 2;
@@ -120,25 +160,7 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
     p.segment = o.segment > 0 ? o.segment : 0;
     return p;
   }
-  // Peaks of the spectrum in dB, above 0 Hz and below 0.45 fs.
-  auto peaks_of = [&](const Spectrum& q, std::vector<double>* widths) {
-    Eigen::VectorXd db(q.level.size());
-    for (Eigen::Index k = 0; k < db.size(); ++k) db[k] = 10 * std::log10(std::max(q.level[k], 1e-300));
-    const double top = 0.45 * fs;
-    std::vector<double> in_band;
-    for (Eigen::Index k = 1; k < db.size(); ++k)
-      if (q.f[k] <= top) in_band.push_back(db[k]);
-    const double floor = percentile(in_band, 0.1);
-    std::vector<double> out;
-    for (const SpectrumPeak& pk : spectrum_peaks(q.f, db, q.df * 0.5, top, 10.0))
-      if (pk.level_db >= floor + 10) out.push_back(pk.frequency_hz);
-    std::sort(out.begin(), out.end());
-    if (widths) {
-      widths->clear();
-      for (double f : out) widths->push_back(half_power_width(q, f));
-    }
-    return out;
-  };
+  auto peaks_of = [&](const Spectrum& q, std::vector<double>* widths) { return band_peaks(q, 0.45 * fs, widths); };
   std::vector<double> widths;
   p.peaks_hz = peaks_of(sp, &widths);
   // Resolution: refine continuous records while the lowest peak's half-power width spans < 4 lines.
@@ -157,21 +179,7 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
     p.lowest_peak_damping = widths.empty() ? 0 : widths.front() / (2 * p.lowest_peak_hz);
   }
   // Band from the peaks, unless given.
-  if (o.band_hi_hz <= 0) {
-    if (p.peaks_hz.empty()) {
-      p.band_lo_hz = 0;
-      p.band_hi_hz = 0.45 * fs;
-      p.notes.push_back("no spectral peak stands 10 dB above its surroundings and the noise floor: the whole band below 0.45 fs");
-    } else {
-      p.band_lo_hz = 0.5 * p.peaks_hz.front();
-      p.band_hi_hz = std::min(1.25 * p.peaks_hz.back(), 0.45 * fs);
-      p.band_from_data = true;
-      char b[200];
-      std::snprintf(b, sizeof b, "band %.4g-%.4g Hz from %zu spectral peaks (%.4g to %.4g Hz): 0.5 x the lowest, 1.25 x the highest", p.band_lo_hz,
-                    p.band_hi_hz, p.peaks_hz.size(), p.peaks_hz.front(), p.peaks_hz.back());
-      p.notes.push_back(b);
-    }
-  }
+  if (o.band_hi_hz <= 0) band_from_peaks(p, 0.45 * fs);
   // Segment for continuous records: the lowest peak's half-power bandwidth over 4 lines.
   if (o.segment >= 0) {
     p.segment = o.segment;
@@ -192,6 +200,39 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
     }
   }
   p.resolution_hz = p.segment > 0 ? fs / p.segment : (shortest > 0 ? fs / static_cast<double>(shortest) : 0);
+  return p;
+}
+
+IdentificationPlan plan_identification(const FrfData& frf, const IdentificationOptions& o) {
+  IdentificationPlan p;
+  p.band_lo_hz = o.band_lo_hz;
+  p.band_hi_hz = o.band_hi_hz;
+  const Eigen::Index n = frf.frequency_hz.size();
+  if (n < 8) return p;
+  p.resolution_hz = (frf.frequency_hz[n - 1] - frf.frequency_hz[0]) / static_cast<double>(n - 1);
+  if (o.band_hi_hz > 0) return p;
+  // Evenly spaced lines are needed by the peak widths; FRFs on an uneven grid keep their whole range.
+  Spectrum sp;
+  sp.f = frf.frequency_hz;
+  sp.df = p.resolution_hz;
+  for (Eigen::Index k = 1; k < n; ++k)
+    if (std::abs(frf.frequency_hz[k] - frf.frequency_hz[k - 1] - sp.df) > 0.02 * sp.df) return p;
+  sp.level.resize(n);
+  const int no = frf.num_outputs(), ni = frf.num_inputs();
+  for (Eigen::Index k = 0; k < n; ++k) {
+    Eigen::MatrixXcd Hk(no, ni);
+    for (int i = 0; i < ni; ++i)
+      for (int q = 0; q < no; ++q) Hk(q, i) = frf.H(k, q + i * no);
+    const double s1 = ni == 1 ? Hk.norm() : Eigen::JacobiSVD<Eigen::MatrixXcd>(Hk).singularValues()[0];
+    sp.level[k] = s1 * s1;
+  }
+  std::vector<double> widths;
+  p.peaks_hz = band_peaks(sp, frf.frequency_hz[n - 1], &widths);
+  if (!p.peaks_hz.empty()) {
+    p.lowest_peak_hz = p.peaks_hz.front();
+    p.lowest_peak_damping = widths.front() / (2 * p.lowest_peak_hz);
+  }
+  band_from_peaks(p, frf.frequency_hz[n - 1]);
   return p;
 }
 

@@ -150,8 +150,14 @@ IdentificationSummary identify_once(const std::vector<Recording>& recs, const st
 
 }  // namespace
 
-IdentificationSummary identify_frfs(const FrfData& frf, const IdentificationOptions& io, const std::vector<FrfData>& halves) {
+IdentificationSummary identify_frfs(const FrfData& frf, const IdentificationOptions& io_in, const std::vector<FrfData>& halves) {
+  const IdentificationPlan plan = plan_identification(frf, io_in);
+  IdentificationOptions io = io_in;
+  io.band_lo_hz = plan.band_lo_hz;
+  io.band_hi_hz = plan.band_hi_hz;
   IdentificationSummary s = identify_lscf(frf, io);
+  s.band_from_data = plan.band_from_data;
+  s.notes.insert(s.notes.begin(), plan.notes.begin(), plan.notes.end());
   if (io.split_uncertainty && halves.size() == 2 && !s.modes.empty()) {
     IdentificationOptions h = io;
     h.band_lo_hz = s.band_lo_hz, h.band_hi_hz = s.band_hi_hz;

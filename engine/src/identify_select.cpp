@@ -181,8 +181,25 @@ double indicator_peakness(const Eigen::VectorXd& f, const Eigen::VectorXd& ind, 
   return 0;
 }
 
+namespace {
+// Support of several clusters together: per order the best weight of any of them.
+double joint_support(const std::vector<Candidate>& cands, const std::vector<std::size_t>& group, std::size_t n_orders) {
+  std::map<int, double> best;
+  for (std::size_t k : group) {
+    const PoleCluster& c = cands[k].cluster;
+    for (std::size_t m = 0; m < c.members.size(); ++m) {
+      double& b = best[c.members[m].first];
+      b = std::max(b, c.member_weight[m]);
+    }
+  }
+  double sum = 0;
+  for (const auto& [j, w] : best) sum += w;
+  return sum / static_cast<double>(n_orders);
+}
+}  // namespace
+
 std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& cands, const std::vector<double>& peakness,
-                                                     const IdentificationOptions& o, IdentificationSummary& s) {
+                                                     const IdentificationOptions& o, std::size_t n_orders, IdentificationSummary& s) {
   auto reject = [&](const PoleCluster& c, Rejection r, double value, double limit, int into = -1) {
     RejectedCluster rc;
     rc.frequency_hz = c.frequency_hz;
@@ -195,71 +212,70 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
     rc.merged_into = into;
     s.rejected.push_back(rc);
   };
-  std::vector<std::size_t> pass;
+  // 1. Splits: clusters with a shape, strongest first; a weaker one within the merge window with the same shape
+  //    joins the stronger (one physical mode whose poles drifted over the orders).
+  std::vector<std::size_t> order;
   for (std::size_t k = 0; k < cands.size(); ++k) {
-    const Candidate& c = cands[k];
-    if (c.cluster.support < o.min_cluster_fraction) {
-      reject(c.cluster, Rejection::kFewOrders, c.cluster.support, o.min_cluster_fraction);
-      continue;
-    }
-    const double mpc = modal_phase_collinearity(c.shape);
-    if (mpc < o.min_mpc) {
-      reject(c.cluster, Rejection::kComplexShape, mpc, o.min_mpc);
-      continue;
-    }
-    if (peakness[k] < -o.trough_db) {
-      reject(c.cluster, Rejection::kIndicatorTrough, peakness[k], -o.trough_db);
-      continue;
-    }
-    pass.push_back(k);
+    if (cands[k].shape.size() > 0) order.push_back(k);
+    else reject(cands[k].cluster, Rejection::kFewOrders, cands[k].cluster.support, o.min_cluster_fraction);
   }
-  // Splits: the strongest first; a weaker one within the merge window with the same shape joins it.
-  std::vector<std::size_t> order = pass;
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return cands[a].strength > cands[b].strength; });
   std::vector<std::vector<std::size_t>> groups;
-  std::vector<std::pair<std::size_t, std::size_t>> merged;  // (candidate, group)
+  std::vector<Eigen::VectorXcd> head_shape;
   for (std::size_t k : order) {
     const PoleCluster& c = cands[k].cluster;
     const Eigen::VectorXcd sk = real_normalize(cands[k].shape).cast<std::complex<double>>();
     int into = -1;
-    double mac_into = 0;
     for (std::size_t g = 0; g < groups.size() && into < 0; ++g) {
       const PoleCluster& h = cands[groups[g][0]].cluster;
-      const double tol = std::max(o.merge_tolerance, 2 * std::max(c.damping_ratio, h.damping_ratio));
+      const double tol = std::max(o.merge_tolerance, std::max(c.damping_ratio, h.damping_ratio));
       if (std::abs(c.frequency_hz - h.frequency_hz) > tol * h.frequency_hz) continue;
-      const double mac = complex_mac(sk, real_normalize(cands[groups[g][0]].shape).cast<std::complex<double>>());
-      if (mac >= o.merge_mac) into = static_cast<int>(g), mac_into = mac;
+      if (complex_mac(sk, head_shape[g]) >= o.merge_mac) into = static_cast<int>(g);
     }
     if (into < 0) {
       groups.push_back({k});
+      head_shape.push_back(sk);
     } else {
       groups[static_cast<std::size_t>(into)].push_back(k);
-      merged.emplace_back(k, static_cast<std::size_t>(into));
-      (void)mac_into;
     }
   }
-  std::vector<std::size_t> by_f(groups.size());
-  for (std::size_t g = 0; g < groups.size(); ++g) by_f[g] = g;
-  std::sort(by_f.begin(), by_f.end(), [&](std::size_t a, std::size_t b) { return cands[groups[a][0]].cluster.frequency_hz < cands[groups[b][0]].cluster.frequency_hz; });
-  std::vector<std::size_t> rank(groups.size());
-  for (std::size_t r = 0; r < by_f.size(); ++r) rank[by_f[r]] = r;
-  for (const auto& [k, g] : merged) {
-    const Eigen::VectorXcd sk = real_normalize(cands[k].shape).cast<std::complex<double>>();
-    const double mac = complex_mac(sk, real_normalize(cands[groups[g][0]].shape).cast<std::complex<double>>());
-    reject(cands[k].cluster, Rejection::kSplit, mac, o.merge_mac, static_cast<int>(rank[g]));
+  // 2. Support (of the group), MPC and the mode indicator (of its strongest cluster).
+  std::vector<std::vector<std::size_t>> kept;
+  for (const std::vector<std::size_t>& g : groups) {
+    const Candidate& h = cands[g[0]];
+    const double support = joint_support(cands, g, n_orders);
+    const double mpc = modal_phase_collinearity(h.shape);
+    bool ok = false;
+    if (support < o.min_cluster_fraction) {
+      for (std::size_t k : g) reject(cands[k].cluster, Rejection::kFewOrders, support, o.min_cluster_fraction);
+    } else if (mpc < o.min_mpc) {
+      for (std::size_t k : g) reject(cands[k].cluster, Rejection::kComplexShape, mpc, o.min_mpc);
+    } else if (peakness[g[0]] < -o.trough_db) {
+      for (std::size_t k : g) reject(cands[k].cluster, Rejection::kIndicatorTrough, peakness[g[0]], -o.trough_db);
+    } else {
+      ok = true;
+    }
+    if (ok) kept.push_back(g);
   }
-  std::vector<std::vector<std::size_t>> out;
-  for (std::size_t g : by_f) out.push_back(groups[g]);
+  // Ascending frequency (of the strongest cluster); the splits are listed against the mode they joined.
+  std::sort(kept.begin(), kept.end(), [&](const auto& a, const auto& b) { return cands[a[0]].cluster.frequency_hz < cands[b[0]].cluster.frequency_hz; });
+  for (std::size_t r = 0; r < kept.size(); ++r)
+    for (std::size_t i = 1; i < kept[r].size(); ++i) {
+      const std::size_t k = kept[r][i];
+      const double mac = complex_mac(real_normalize(cands[k].shape).cast<std::complex<double>>(), real_normalize(cands[kept[r][0]].shape).cast<std::complex<double>>());
+      reject(cands[k].cluster, Rejection::kSplit, mac, o.merge_mac, static_cast<int>(r));
+    }
   std::sort(s.rejected.begin(), s.rejected.end(), [](const RejectedCluster& a, const RejectedCluster& b) { return a.frequency_hz < b.frequency_hz; });
-  return out;
+  return kept;
 }
 
 void make_modes(const std::vector<Candidate>& cands, const std::vector<double>& peakness, const std::vector<std::vector<std::size_t>>& accepted,
-                IdentificationSummary& s) {
+                std::size_t n_orders, IdentificationSummary& s) {
   s.modes.clear();
   for (const std::vector<std::size_t>& g : accepted) {
     const Candidate& c = cands[g[0]];
     IdentifiedMode m;
+    // Frequency, damping and their spreads are the strongest cluster's (a split's drifted poles would bias them).
     m.frequency_hz = c.cluster.frequency_hz;
     m.damping_ratio = c.cluster.damping_ratio;
     m.order_frequency_std_hz = m.frequency_std_hz = c.cluster.frequency_std_hz;
@@ -268,12 +284,11 @@ void make_modes(const std::vector<Candidate>& cands, const std::vector<double>& 
     m.shape = c.shape;
     m.mpc = modal_phase_collinearity(c.shape);
     m.real_shape = real_normalize(c.shape);
+    m.support = joint_support(cands, g, n_orders);
     for (std::size_t k : g) {
-      m.support += cands[k].cluster.support;
       m.poles += cands[k].cluster.poles;
       for (int d : cands[k].cluster.diagram_index) s.poles[static_cast<std::size_t>(d)].cluster = static_cast<int>(s.modes.size());
     }
-    m.support = std::min(1.0, m.support);
     s.modes.push_back(std::move(m));
   }
 }

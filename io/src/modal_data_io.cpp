@@ -100,6 +100,7 @@ ModalData parse_modal_data_json(const std::string& text, const std::string& name
   optional("mpc", &d.mpc);
   optional("frequency_std_hz", &d.frequency_std_hz);
   optional("damping_std", &d.damping_std);
+  optional("shape_std", &d.shape_std);
   d.validate(name);
   return d;
 }
@@ -116,6 +117,7 @@ nlohmann::ordered_json modal_data_json(const ModalData& d) {
     if (d.damping_ratios.size() == d.frequencies_hz.size()) m["damping_ratio"] = d.damping_ratios[k];
     if (d.frequency_std_hz.size() == d.frequencies_hz.size()) m["frequency_std_hz"] = d.frequency_std_hz[k];
     if (d.damping_std.size() == d.frequencies_hz.size()) m["damping_std"] = d.damping_std[k];
+    if (d.shape_std.size() == d.frequencies_hz.size()) m["shape_std"] = d.shape_std[k];
     if (d.mpc.size() == d.frequencies_hz.size()) m["mpc"] = d.mpc[k];
     nlohmann::ordered_json sh = nlohmann::ordered_json::object();
     for (std::size_t r = 0; r < d.dofs.size(); ++r) sh[to_string(d.dofs[r])] = d.shapes(static_cast<Eigen::Index>(r), k);

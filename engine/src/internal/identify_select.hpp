@@ -48,16 +48,22 @@ struct Candidate {
   double strength = 0;  ///< which of two splits is the stronger (support)
 };
 
-/// Step 3: the checks, on candidates with shapes (those below the support limit need none). Returns the
-/// accepted modes, ascending in frequency, each as the candidate it is followed by the splits merged into it;
-/// appends every rejected candidate to s.rejected (merged_into = index in the returned list). `peakness` gives
-/// a candidate's indicator_peakness.
+/// Step 3: the checks, on candidates with shapes (those without one, below the shaping limit, are rejected for
+/// their support). Splits are merged first (a weaker cluster within the merge window with the same shape joins
+/// the stronger), then each group is checked: joint support, MPC and mode indicator of its strongest cluster.
+/// Returns the accepted modes, ascending in frequency, each as its strongest candidate followed by the splits
+/// merged into it; appends every rejected candidate to s.rejected. `peakness` gives each candidate's
+/// indicator_peakness; `n_orders` the number of model orders.
 std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& candidates, const std::vector<double>& peakness,
-                                                     const IdentificationOptions& o, IdentificationSummary& s);
+                                                     const IdentificationOptions& o, std::size_t n_orders, IdentificationSummary& s);
 
-/// The accepted modes as IdentifiedModes (frequency, damping, spreads, support, shape), and the diagram's poles
-/// marked with their mode.
+/// The accepted modes as IdentifiedModes (frequency, damping, spreads and shape of the strongest cluster, the
+/// joint support of all), and the diagram's poles marked with their mode.
 void make_modes(const std::vector<Candidate>& candidates, const std::vector<double>& peakness, const std::vector<std::vector<std::size_t>>& accepted,
-                IdentificationSummary& s);
+                std::size_t n_orders, IdentificationSummary& s);
+
+/// Clusters with at least this share of min_cluster_fraction get a shape and the evidence checks (weaker ones
+/// are rejected for their support without one).
+constexpr double kShapedShare = 1.0 / 3.0;
 
 }  // namespace dynid::internal

@@ -18,9 +18,10 @@
 //        mode indicator (CMIF for FRFs, the first singular value of the output spectral matrix for output-only
 //          data) more than trough_db below the straight line (in dB) between its values a few half-power
 //          bandwidths either side: the pole sits in a trough (an anti-resonance), not on a peak or a shoulder;
-//        a split: within max(merge_tolerance, 2 zeta) in frequency of a stronger cluster with a shape MAC >=
-//          merge_mac: one physical mode whose poles drifted over orders; the weaker's support is added to the
-//          stronger.
+//        a split: within max(merge_tolerance, zeta) in frequency of a stronger cluster (one half-power
+//          half-bandwidth) with a shape MAC >= merge_mac: one physical mode whose poles drifted over orders. Splits
+//          are merged before the other checks: the group's support counts, per order, its best pole; its
+//          frequency, damping and shape are the strongest cluster's.
 // Uncertainty: the spread over orders understates the scatter of a mode from one data set to the next. With
 // recordings (identify_recordings), the two halves of the data (records, or the two halves in time of one
 // record) are identified again with the same settings; halves' modes are paired with the full data's by MAC;
@@ -59,7 +60,7 @@ struct IdentificationOptions {
   // Evidence a cluster needs to be reported as a mode (see the header comment).
   double min_mpc = 0.5;             ///< modal phase collinearity of its shape
   double trough_db = 3;             ///< how far below its surroundings the mode indicator may sit
-  double merge_tolerance = 0.03;    ///< clusters this close (relative, or 2 zeta if wider) ...
+  double merge_tolerance = 0.03;    ///< clusters this close (relative, or zeta if wider) ...
   double merge_mac = 0.9;           ///< ... with shapes this alike are one mode
   // SSI-cov.
   int block_rows = 0;  ///< i (0 = automatic from the band's lowest frequency and the maximum order)
@@ -170,6 +171,9 @@ struct IdentificationPlan {
   std::vector<std::string> notes;
 };
 IdentificationPlan plan_identification(const std::vector<Recording>& recordings, const IdentificationOptions& options);
+/// The band of FRFs by the same rule, from the peaks of their CMIF (first singular value at every line); the
+/// resolution is the FRFs' own.
+IdentificationPlan plan_identification(const FrfData& frf, const IdentificationOptions& options);
 
 /// LSCF (poly-reference when the FRFs have several inputs) on FRFs; shapes by LSFD with lower and upper
 /// residuals at the selected poles. Any response quantity works (poles do not depend on it); shapes are
@@ -190,8 +194,8 @@ FrfData merge_frfs(std::vector<FrfData> sets);
 /// split-data uncertainty (header comment) when options.split_uncertainty.
 IdentificationSummary identify_recordings(std::vector<Recording> recordings, const std::string& method,
                                           const IdentificationOptions& options);
-/// FRFs identified with LSCF, with the split-data uncertainty when `halves` holds the FRFs of the two halves of
-/// the data (e.g. of alternate hits), else without.
+/// FRFs identified with LSCF (the band from plan_identification where the options leave it open), with the
+/// split-data uncertainty when `halves` holds the FRFs of the two halves of the data (e.g. of alternate hits).
 IdentificationSummary identify_frfs(const FrfData& frf, const IdentificationOptions& options, const std::vector<FrfData>& halves = {});
 
 /// Peaks of a magnitude spectrum (e.g. a dB spectrum without phase): local maxima in [lo, hi] standing at
