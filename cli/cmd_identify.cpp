@@ -13,6 +13,7 @@
 #include "dynid/io/modal_data_io.hpp"
 #include "dynid/io/output.hpp"
 #include "dynid/io/test_data.hpp"
+#include "dynid/io/test_layout.hpp"
 #include "dynid/io/uff.hpp"
 #include "dynid/mesh/error.hpp"
 #include "progress.hpp"
@@ -29,6 +30,7 @@ struct IdentifyArgs {
   std::vector<double> band, orders;
   std::vector<std::string> outputs, inputs;  // DOF labels for FRF text files
   bool frf_text = false, force = false;
+  std::string as;  // what text tables hold: "" (by content), time, frf, spectrum
   double fs = 0, exponential = 0;
   int segment = -1;
   std::string estimator = "h1";
@@ -83,6 +85,29 @@ int report_spectrum_peaks(const TextTable& t, const std::vector<double>& band, c
   return 0;
 }
 
+// Rejected clusters worth a line: those with a quarter of the orders or more, and every split.
+void print_rejected(const IdentificationSummary& s) {
+  int shown = 0, rest = 0;
+  for (const RejectedCluster& r : s.rejected) {
+    if (r.support < 0.25 && r.reason != Rejection::kSplit) {
+      ++rest;
+      continue;
+    }
+    if (shown++ == 0) fmt::print("  not reported (clusters of poles without the evidence of a mode):\n");
+    std::string why;
+    switch (r.reason) {
+      case Rejection::kFewOrders: why = fmt::format("stable over {:.0f} % of the orders (< {:.0f} %)", 100 * r.value, 100 * r.limit); break;
+      case Rejection::kComplexShape: why = fmt::format("complex shape, MPC {:.2f} < {:.2f}: noise or a mathematical pole", r.value, r.limit); break;
+      case Rejection::kIndicatorTrough:
+        why = fmt::format("the mode indicator sits {:.1f} dB below its surroundings (a trough, not a peak)", -r.value);
+        break;
+      case Rejection::kSplit: why = fmt::format("a split of mode {} (same shape, MAC {:.3f}): merged into it", r.merged_into + 1, r.value); break;
+    }
+    fmt::print("        {:<14.6g}  {:<11.4g}  {:3d} poles  {}\n", r.frequency_hz, 100 * r.damping_ratio, r.poles, why);
+  }
+  if (rest > 0) fmt::print("  ({} more clusters stable over fewer than 25 % of the orders: in the JSON)\n", rest);
+}
+
 int run_identify(const IdentifyArgs& a, const GlobalOptions& g) {
   set_threads(g.threads);
   Progress progress(!g.quiet);
@@ -90,74 +115,38 @@ int run_identify(const IdentifyArgs& a, const GlobalOptions& g) {
   IdentificationOptions io;
   if (!a.band.empty()) io.band_lo_hz = a.band[0], io.band_hi_hz = a.band[1];
   if (!a.orders.empty()) io.min_order = static_cast<int>(a.orders[0]), io.max_order = static_cast<int>(a.orders[1]);
+  io.segment = a.segment;
+  io.estimator = a.estimator == "h2" ? FrfOptions::Estimator::kH2 : FrfOptions::Estimator::kH1;
+  io.exponential_end = a.exponential;
   std::string why;
   if (!io.IsValid(&why)) throw InputError("identify: " + why);
 
-  std::vector<FrfData> frfs;
-  std::vector<Recording> recs;
-  if (a.frf_text) {
-    const std::vector<MeasuredDof> outs = labels(a.outputs, "--outputs"), ins = labels(a.inputs, "--inputs");
-    if (outs.size() != a.files.size() && outs.size() != 1)
-      throw InputError("identify: --frf needs one --outputs DOF per file (or one for all); got " + std::to_string(outs.size()) + " for " +
-                       std::to_string(a.files.size()) + " files");
-    if (ins.size() != a.files.size() && ins.size() != 1)
-      throw InputError("identify: --frf needs one --inputs DOF per file (or one for all)");
-    std::vector<MeasuredDof> o(a.files.size()), i(a.files.size());
-    for (std::size_t k = 0; k < a.files.size(); ++k) {
-      o[k] = outs[outs.size() == 1 ? 0 : k];
-      i[k] = ins[ins.size() == 1 ? 0 : k];
-    }
-    frfs.push_back(read_frf_text_set(a.files, o, i));
-  } else {
-    for (const std::string& f : a.files) {
-      TestData d = read_test_data(f, a.fs);
-      if (d.kind == TestData::Kind::kUff) {
-        bool has_frf = false, has_time = false;
-        for (const UffDataset& ds : d.uff.datasets)
-          if (const Uff58* u = std::get_if<Uff58>(&ds.data)) {
-            has_frf = has_frf || u->function_type == 4;
-            has_time = has_time || u->function_type == 1;
-          }
-        if (has_frf) frfs.push_back(uff_frf(d.uff));
-        else if (has_time) recs.push_back(uff_recording(d.uff));
-        else throw InputError(f + ": holds no time responses (58, function type 1) and no FRFs (58, type 4)");
-      } else if (d.kind == TestData::Kind::kTimeHistory) {
-        recs.push_back(std::move(d.recording));
-      } else {
-        if (a.files.size() > 1) throw InputError(f + ": a magnitude spectrum is identified on its own (peak picking); give it alone");
-        return report_spectrum_peaks(d.table, a.band, g);
-      }
-    }
-  }
-  if (!frfs.empty() && !recs.empty()) throw InputError("identify: give either FRFs or time recordings, not both");
+  TestSetOptions to;
+  to.sample_rate_hz = a.fs;
+  if (a.frf_text || a.as == "frf") to.kind = TableKind::kFrf;
+  else if (a.as == "time") to.kind = TableKind::kTimeHistory;
+  else if (a.as == "spectrum") to.kind = TableKind::kSpectrum;
+  if (!a.outputs.empty()) to.frf_outputs = labels(a.outputs, "--outputs");
+  if (!a.inputs.empty()) to.frf_inputs = labels(a.inputs, "--inputs");
+  const TestSet set = read_test_set(a.files, to);
+  if (set.kind == TestSet::Kind::kSpectrum) return report_spectrum_peaks(set.spectrum, a.band, g);
+  set.require_consistent();
 
   std::string method = a.method;
-  bool has_inputs = false;
-  for (const Recording& r : recs) has_inputs = has_inputs || !r.input_channels().empty();
-  if (method.empty()) method = !frfs.empty() || has_inputs ? "lscf" : "ssi";
   IdentificationSummary s;
-  progress.update("identifying (" + method + ")", -1);
-  if (method == "lscf") {
-    if (frfs.empty()) {
-      if (!has_inputs) throw InputError("identify: LSCF needs FRFs or recordings with a force channel; these are output-only: use --method ssi");
-      FrfOptions fo;
-      fo.estimator = a.estimator == "h2" ? FrfOptions::Estimator::kH2 : FrfOptions::Estimator::kH1;
-      fo.segment = a.segment >= 0 ? a.segment : 0;
-      fo.exponential_end = a.exponential;
-      if (io.band_hi_hz > 0) fo.max_frequency_hz = std::min(1.25 * io.band_hi_hz, recs[0].sample_rate_hz / 2);
-      frfs.push_back(estimate_frf(recs, fo));
-    }
-    s = identify_lscf(merge_frfs(std::move(frfs)), io);
+  if (set.kind == TestSet::Kind::kFrf) {
+    if (method == "ssi") throw InputError("identify: SSI works on time recordings (output-only); FRFs go to --method lscf");
+    method = "lscf";
+    progress.update("identifying (lscf)", -1);
+    s = identify_frfs(set.frf, io);
   } else {
-    if (recs.empty()) throw InputError("identify: SSI works on time recordings (output-only); FRFs go to --method lscf");
-    if (recs.size() > 1) {
-      for (std::size_t k = 1; k < recs.size(); ++k) {
-        if (recs[k].sample_rate_hz != recs[0].sample_rate_hz || recs[k].num_channels() != recs[0].num_channels())
-          throw InputError("identify: recordings identified together need the same channels and sampling rate (" + recs[k].source + ")");
-        recs[0].records.insert(recs[0].records.end(), recs[k].records.begin(), recs[k].records.end());
-      }
-    }
-    s = identify_ssi(recs[0], io);
+    const std::vector<Recording> recs = set.recordings();
+    bool has_inputs = false;
+    for (const Recording& r : recs) has_inputs = has_inputs || !r.input_channels().empty();
+    if (method.empty()) method = has_inputs ? "lscf" : "ssi";
+    if (method == "lscf" && !has_inputs) throw InputError("identify: LSCF needs FRFs or recordings with a force channel; these are output-only: use --method ssi");
+    progress.update("identifying (" + method + ")", -1);
+    s = identify_recordings(recs, method, io);
   }
   progress.done();
 
@@ -169,11 +158,26 @@ int run_identify(const IdentifyArgs& a, const GlobalOptions& g) {
   // Refuse before writing anything if an output exists (no partial results).
   refuse_existing({json, uff, png}, a.force);
   if (md.frequencies_hz.size() > 0) write_uff55(uff, md, a.force);
-  write_file_atomic(json, identification_json(s).dump(1) + "\n", a.force);
+  nlohmann::ordered_json j = identification_json(s);
+  nlohmann::ordered_json tests = nlohmann::ordered_json::array();
+  for (const TestGroup& t : set.tests) tests.push_back(t.summary());
+  if (!tests.empty()) j["tests"] = tests;
+  nlohmann::ordered_json notes = nlohmann::ordered_json::array();
+  for (const std::string& n : set.read_as) notes.push_back(n);
+  for (const std::string& n : set.notes) notes.push_back(n);
+  for (const auto& n : j["notes"]) notes.push_back(n);
+  j["notes"] = notes;
+  write_file_atomic(json, j.dump(1) + "\n", a.force);
   plot::save(stabilization_figure(s, "dynid identify: " + fs::path(a.files[0]).filename().string() + (a.files.size() > 1 ? " ..." : "")), png, a.force);
 
   if (!g.quiet) {
-    fmt::print("dynid identify: {} on {} output DOFs, orders {}-{}, {:.2f} s\n", method, s.dofs.size(), s.min_order, s.max_order, s.seconds);
+    for (std::size_t k = 0; k < set.tests.size(); ++k) fmt::print("dynid identify: test {}: {}\n", k + 1, set.tests[k].summary());
+    if (set.kind == TestSet::Kind::kFrf)
+      fmt::print("dynid identify: FRFs, {} outputs x {} inputs, {} lines\n", set.frf.num_outputs(), set.frf.num_inputs(), set.frf.frequency_hz.size());
+    for (const std::string& n : set.notes) fmt::print("  note: {}\n", n);
+    fmt::print("dynid identify: {} on {} output DOFs, band {:.5g}-{:.5g} Hz{}, lines {:.4g} Hz, orders {}-{}, {:.2f} s\n", method, s.dofs.size(), s.band_lo_hz,
+               s.band_hi_hz, s.band_from_data ? " (from the spectral peaks)" : "", s.resolution_hz, s.min_order, s.max_order, s.seconds);
+    for (const std::string& n : s.notes) fmt::print("  {}\n", n);
     if (s.window_decay_removed > 0) fmt::print("  exponential window: {:.4g} 1/s of decay taken off every pole\n", s.window_decay_removed);
     fmt::print("  mode  frequency [Hz]  (std)     damping [%]  (std)    MPC     poles  {}  assessment\n", method == "lscf" ? "contribution" : "");
     for (std::size_t k = 0; k < s.modes.size(); ++k) {
@@ -183,6 +187,7 @@ int run_identify(const IdentifyArgs& a, const GlobalOptions& g) {
                  describe_mode(s, k));
     }
     if (s.modes.empty()) fmt::print("  no stable physical poles in the band: widen the band or raise the maximum order\n");
+    print_rejected(s);
     fmt::print("  wrote {}, {}{}\n", json, md.frequencies_hz.size() ? uff + ", " : "", png);
   }
   return 0;
@@ -191,6 +196,7 @@ int run_identify(const IdentifyArgs& a, const GlobalOptions& g) {
 struct SimulateArgs {
   std::string case_path, output;
   bool force = false;
+  bool per_channel = false;  ///< one file per channel (as many acquisition systems export) instead of one per test
 };
 
 /// Writes the recordings (one file per hit location); their paths go to `written_out` if not null.
@@ -208,15 +214,26 @@ int run_simulate(const SimulateArgs& a, const GlobalOptions& g, std::vector<std:
   std::vector<std::string> written;
   std::size_t datasets = 0;
   for (std::size_t k = 0; k < vt.recordings.size(); ++k) {
-    std::string path = out;
-    if (vt.recordings.size() > 1) {
-      const fs::path p(out);
-      path = (p.parent_path() / (p.stem().string() + "-" + to_string(t.options.inputs[k]) + p.extension().string())).string();
-    }
+    const fs::path p(out);
+    const std::string stem = (p.parent_path() / p.stem()).string() + (vt.recordings.size() > 1 ? "-" + to_string(t.options.inputs[k]) : "");
     const std::vector<UffDataset> ds = uff_datasets(vt.recordings[k], t.binary);
     datasets += ds.size();
-    write_uff(path, ds, a.force);
-    written.push_back(path);
+    if (!a.per_channel) {
+      const std::string path = stem + p.extension().string();
+      write_uff(path, ds, a.force);
+      written.push_back(path);
+      continue;
+    }
+    // One file per channel: its datasets (one per record) in order; the reference DOF tells the tests apart.
+    const Recording& r = vt.recordings[k];
+    for (int c = 0; c < r.num_channels(); ++c) {
+      std::vector<UffDataset> mine;
+      for (std::size_t d = static_cast<std::size_t>(c); d < ds.size(); d += static_cast<std::size_t>(r.num_channels())) mine.push_back(ds[d]);
+      const Channel& ch = r.channels[static_cast<std::size_t>(c)];
+      const std::string path = stem + "-" + to_string(ch.dof) + (ch.input ? "-force" : "") + p.extension().string();
+      write_uff(path, mine, a.force);
+      written.push_back(path);
+    }
   }
   const std::string truth = fs::path(out).replace_extension(".truth.json").string();
   write_modal_data(truth, vt.modes, a.force);
@@ -225,7 +242,10 @@ int run_simulate(const SimulateArgs& a, const GlobalOptions& g, std::vector<std:
     for (const Recording& r : vt.recordings) records += r.records.size();
     fmt::print("dynid simulate-test: {} — {} sensors, {} records of {} samples at {} Hz, {} modes below Nyquist\n", c.name,
                t.options.sensors.size(), records, vt.recordings[0].records[0].rows(), t.options.sample_rate_hz, vt.modes.num_modes());
-    for (const std::string& w : written) fmt::print("  wrote {}\n", w);
+    if (written.size() <= 6)
+      for (const std::string& w : written) fmt::print("  wrote {}\n", w);
+    else
+      fmt::print("  wrote {} files, one per channel: {} ... {}\n", written.size(), written.front(), written.back());
     fmt::print("  ({} datasets, UFF 58{}); the simulated modes (the truth) in {}\n", datasets, t.binary ? "b" : "", truth);
   }
   if (written_out) *written_out = written;
@@ -239,7 +259,7 @@ int test_step(const std::string& case_path, const std::string& dir, bool force, 
   require_section(c, c.test.has_value(), "test");
   const std::string uff = (fs::path(dir) / "test.uff").string();
   IdentifyArgs a;  // identifies exactly the files simulate-test wrote (test.uff, or test-<input>.uff per hit)
-  if (const int rc = run_simulate(SimulateArgs{case_path, uff, force}, g, &a.files); rc != 0) return rc;
+  if (const int rc = run_simulate(SimulateArgs{case_path, uff, force, false}, g, &a.files); rc != 0) return rc;
   const IdentificationOptions& io = c.test->identify;
   if (io.band_hi_hz > 0) a.band = {io.band_lo_hz, io.band_hi_hz};
   if (io.max_order > 0) a.orders = {static_cast<double>(io.min_order), static_cast<double>(io.max_order)};
@@ -254,23 +274,28 @@ int test_step(const std::string& case_path, const std::string& dir, bool force, 
 void register_identify(CLI::App& app, GlobalOptions& g) {
   auto a = std::make_shared<IdentifyArgs>();
   CLI::App* cmd = app.add_subcommand("identify", "Modal identification from recordings: LSCF + LSFD (FRFs, or force and responses) or SSI-cov (output-only)");
-  cmd->add_option("RECORDINGS", a->files, "UFF 58 files (time or FRF), text/CSV time histories, LabVIEW .lvm, or FRF text files with --frf")
+  cmd->add_option("RECORDINGS", a->files,
+                  "Test files in any layout (one per channel, per test, per hit...): UFF 58/58b (time or FRF), text/CSV (time histories, FRF "
+                  "re/im columns, spectra: recognised by content), LabVIEW .lvm")
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--method", a->method, "lscf or ssi (default: lscf when there are FRFs or a force channel, else ssi)")
       ->check(CLI::IsMember({"lscf", "ssi"}));
-  cmd->add_option("--band", a->band, "Analysis band LO HI in Hz")->expected(2);
+  cmd->add_option("--band", a->band, "Analysis band LO HI in Hz (default: from the spectral peaks, 0.5 x the lowest to 1.25 x the highest)")->expected(2);
   cmd->add_option("--orders", a->orders, "Model orders MIN MAX")->expected(2);
   cmd->add_option("--json", a->json, "Modal data JSON (default: <first file>-<method>-modes.json)");
   cmd->add_option("--uff", a->uff, "Modal data UFF 55 (default: <first file>-<method>-modes.uff)");
   cmd->add_option("--plot", a->plot, "Stabilization diagram .png/.svg (default: <first file>-<method>-stabilization.png)");
   cmd->add_option("--out", a->out_stem, "Stem for the default output names");
-  cmd->add_flag("--frf", a->frf_text, "The files are FRF text files (frequency, real, imaginary)");
-  cmd->add_option("--outputs", a->outputs, "With --frf: output DOF of each file (or one for all), e.g. 1ux,2ux")->delimiter(',');
-  cmd->add_option("--inputs", a->inputs, "With --frf: input DOF of each file (or one for all)")->delimiter(',');
+  cmd->add_flag("--frf", a->frf_text, "The text files are FRFs (frequency, real, imaginary): the same as --as frf");
+  cmd->add_option("--as", a->as, "What text tables hold, overriding what their content says: time, frf or spectrum")
+      ->check(CLI::IsMember({"time", "frf", "spectrum"}));
+  cmd->add_option("--outputs", a->outputs, "FRF text files: output DOF of each FRF (or one for all), e.g. 1ux,2ux (default: point k for FRF k)")->delimiter(',');
+  cmd->add_option("--inputs", a->inputs, "FRF text files: input DOF of each FRF (or one for all) (default: one common reference)")->delimiter(',');
   cmd->add_option("--fs", a->fs, "Sampling rate for text files without a time column (Hz)");
   cmd->add_option("--estimator", a->estimator, "FRF estimator for force + response recordings: h1 or h2")->check(CLI::IsMember({"h1", "h2"}));
-  cmd->add_option("--segment", a->segment, "Welch segment length in samples (default: whole records, for impacts)");
+  cmd->add_option("--segment", a->segment,
+                  "FRF / spectrum segment in samples for continuous records (default: from the lowest spectral peak's bandwidth; 0 = whole records; impacts always use whole records)");
   cmd->add_option("--exponential", a->exponential, "Exponential window on impact records: its end value, e.g. 0.05 (its damping is removed)");
   cmd->add_flag("--force", a->force, "Overwrite existing output files");
   cmd->callback([a, &g]() { g.exit_code = run_guarded("identify", [&] { return run_identify(*a, g); }); });
@@ -280,6 +305,7 @@ void register_identify(CLI::App& app, GlobalOptions& g) {
   sim->add_option("CASE", s->case_path, "Case file or folder with a test: section")->required();
   sim->add_option("-o,--output", s->output, "UFF file to write (default: the case's test output, or <case>-test.uff beside it)");
   sim->add_flag("--force", s->force, "Overwrite existing output files");
+  sim->add_flag("--per-channel", s->per_channel, "One UFF file per channel (<output stem>[-<hammer DOF>]-<DOF>[-force].uff), as many acquisition systems export");
   sim->callback([s, &g]() { g.exit_code = run_guarded("simulate-test", [&] { return run_simulate(*s, g); }); });
 }
 

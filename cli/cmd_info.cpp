@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 #include "dynid/io/test_data.hpp"
+#include "dynid/io/test_layout.hpp"
 #include "dynid/io/uff.hpp"
 
 namespace dynid::cli {
@@ -91,25 +92,67 @@ void print_table(const std::string& path, const TextTable& t) {
     fmt::print("  {:<24}{}\n", t.names[c], t.units[c].empty() ? "" : " [" + t.units[c] + "]");
 }
 
-int info_file(const std::string& path, const InfoArgs& a) {
-  const TestData d = read_test_data(path, a.fs);
+void print_frf_table(const std::string& path, const TextTable& t) {
+  const auto n = t.x.size();
+  fmt::print("{}: FRF table, {} FRF{} (real, imaginary pairs), step {:.6g}, {} lines ({:.6g} .. {:.6g})\n", path, t.columns.cols() / 2,
+             t.columns.cols() > 2 ? "s" : "", t.dx, n, n ? t.x[0] : 0.0, n ? t.x[n - 1] : 0.0);
+}
+
+int info_file(const std::string& path, const InfoArgs& a, std::vector<TestData>* read) {
+  TestData d = read_test_data(path, a.fs);
   switch (d.kind) {
     case TestData::Kind::kUff: print_uff(d.uff); break;
     case TestData::Kind::kTimeHistory: print_recording(path, d.recording); break;
     case TestData::Kind::kSpectrum: print_table(path, d.table); break;
+    case TestData::Kind::kFrf: print_frf_table(path, d.table); break;
   }
+  if (!d.how.empty()) fmt::print("  read as: {}\n", d.how);
+  read->push_back(std::move(d));
   return 0;
+}
+
+// How the files group into tests (test_layout.hpp): one line per test, then the notes and inconsistencies.
+int info_groups(const std::vector<TestData>& files, const std::vector<std::string>& paths, const InfoArgs& a) {
+  TestSetOptions o;
+  o.sample_rate_hz = a.fs;
+  const TestSet s = assemble_test_set(files, paths, o);
+  if (s.kind == TestSet::Kind::kRecordings) {
+    fmt::print("{} test{} in {} file{}:\n", s.tests.size(), s.tests.size() == 1 ? "" : "s", paths.size(), paths.size() == 1 ? "" : "s");
+    for (std::size_t k = 0; k < s.tests.size(); ++k) fmt::print("  test {}: {}\n", k + 1, s.tests[k].summary());
+  } else if (s.kind == TestSet::Kind::kFrf) {
+    fmt::print("FRFs: {} outputs x {} inputs, {} lines ({:.6g} .. {:.6g} Hz), from {} file{}\n", s.frf.num_outputs(), s.frf.num_inputs(),
+               s.frf.frequency_hz.size(), s.frf.frequency_hz[0], s.frf.frequency_hz[s.frf.frequency_hz.size() - 1], paths.size(),
+               paths.size() == 1 ? "" : "s");
+  }
+  for (const std::string& n : s.notes) fmt::print("  note: {}\n", n);
+  for (const std::string& p : s.problems) fmt::print("  inconsistent: {}\n", p);
+  return s.problems.empty() ? 0 : 2;
 }
 }  // namespace
 
 void register_info(CLI::App& app, GlobalOptions& g) {
   auto a = std::make_shared<InfoArgs>();
-  CLI::App* cmd = app.add_subcommand("info", "What test-data files hold: UFF datasets, text and LabVIEW channels");
+  CLI::App* cmd = app.add_subcommand("info", "What test-data files hold: UFF datasets, text and LabVIEW channels, and how they group into tests");
   cmd->add_option("FILE", a->files, "UFF (.uff/.unv), LabVIEW (.lvm) or text (.txt/.csv) files")->required();
   cmd->add_option("--fs", a->fs, "Sampling rate [Hz] of text files without a time column")->check(CLI::PositiveNumber);
   cmd->callback([a, &g]() {
     int rc = 0;
-    for (const std::string& f : a->files) rc = std::max(rc, run_guarded("info", [&] { return info_file(f, *a); }));
+    std::vector<TestData> read;
+    std::vector<std::string> paths;
+    for (const std::string& f : a->files) {
+      const std::size_t before = read.size();
+      rc = std::max(rc, run_guarded("info", [&] { return info_file(f, *a, &read); }));
+      if (read.size() > before) paths.push_back(f);
+    }
+    // The grouping only when every file was read and they hold test data (not only geometry or modes).
+    bool data = false;
+    for (const TestData& d : read) {
+      if (d.kind != TestData::Kind::kUff) data = true;
+      else
+        for (const UffDataset& ds : d.uff.datasets)
+          if (const Uff58* u = std::get_if<Uff58>(&ds.data)) data = data || u->function_type == 1 || u->function_type == 4;
+    }
+    if (rc == 0 && data) rc = std::max(rc, run_guarded("info", [&] { return info_groups(read, paths, *a); }));
     g.exit_code = rc;
   });
 }

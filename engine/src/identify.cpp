@@ -11,146 +11,23 @@
 #include "dynid/engine/frf.hpp"
 #include "dynid/mesh/error.hpp"
 #include "dynid/solvers/signal.hpp"
+#include "internal/identify_select.hpp"
 
 namespace dynid {
+
+using internal::complex_mac;
+using internal::Candidate;
+using internal::PoleCluster;
+using internal::RawPole;
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 using Clock = std::chrono::steady_clock;
 
-// A pole of one model order with the vector the stability check compares (participation or shape).
-struct RawPole {
-  std::complex<double> lambda;  // continuous time, rad/s, Im > 0
-  Eigen::VectorXcd vec;
-};
-
-double pole_hz(std::complex<double> l) { return std::abs(l) / (2 * kPi); }
-double pole_zeta(std::complex<double> l) { return -l.real() / std::abs(l); }
-
-double complex_mac(const Eigen::VectorXcd& a, const Eigen::VectorXcd& b) {
-  const double d = a.squaredNorm() * b.squaredNorm();
-  return d > 0 ? std::norm(a.dot(b)) / d : 0.0;
-}
-
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-double stddev(const std::vector<double>& v) {
-  if (v.size() < 2) return 0;
-  double m = 0, s = 0;
-  for (double x : v) m += x;
-  m /= static_cast<double>(v.size());
-  for (double x : v) s += (x - m) * (x - m);
-  return std::sqrt(s / static_cast<double>(v.size() - 1));
-}
-
-// Stabilization diagram and automatic selection. `orders[j]` holds the poles found at model order `order_of[j]`.
-// Returns, per selected mode, the (order index, pole index) of the pole nearest the cluster's median frequency.
-std::vector<std::pair<int, int>> stabilize_and_select(const std::vector<std::vector<RawPole>>& orders, const std::vector<int>& order_of,
-                                                      double lo, double hi, const IdentificationOptions& o,
-                                                      IdentificationSummary& s) {
-  std::vector<std::pair<int, int>> where;  // pole index in s.poles -> (j, p)
-  for (std::size_t j = 0; j < orders.size(); ++j)
-    for (std::size_t p = 0; p < orders[j].size(); ++p) {
-      const RawPole& rp = orders[j][p];
-      StabilizationPole sp;
-      sp.order = order_of[j];
-      sp.frequency_hz = pole_hz(rp.lambda);
-      sp.damping_ratio = pole_zeta(rp.lambda);
-      sp.physical = sp.frequency_hz >= lo && sp.frequency_hz <= hi && sp.damping_ratio > 0 && sp.damping_ratio < o.max_damping;
-      if (j > 0 && !orders[j - 1].empty()) {
-        const RawPole* best = nullptr;
-        double bd = 1e300;
-        for (const RawPole& q : orders[j - 1]) {
-          const double d = std::abs(pole_hz(q.lambda) - sp.frequency_hz);
-          if (d < bd) bd = d, best = &q;
-        }
-        const double zq = pole_zeta(best->lambda);
-        sp.stable_frequency = bd <= o.stable_frequency * sp.frequency_hz;
-        sp.damping_change = std::abs(zq - sp.damping_ratio) / std::max(std::abs(sp.damping_ratio), 1e-12);
-        sp.stable_damping = sp.damping_change <= o.stable_damping;
-        sp.stable_vector = rp.vec.size() <= 1 || complex_mac(rp.vec, best->vec) >= o.stable_mac;
-      }
-      s.poles.push_back(sp);
-      where.emplace_back(static_cast<int>(j), static_cast<int>(p));
-    }
-  // Candidates: physical poles stable in frequency and vector, and in damping within the looser cluster_damping
-  // (damping estimates scatter more than frequencies on real data; a cluster's damping is its median).
-  std::vector<int> cand;
-  for (std::size_t i = 0; i < s.poles.size(); ++i)
-    if (s.poles[i].physical && s.poles[i].stable_frequency && s.poles[i].stable_vector && s.poles[i].damping_change <= o.cluster_damping) cand.push_back(static_cast<int>(i));
-  // Seeded clustering: the candidate with the most candidates within +-tol (relative frequency) seeds a cluster,
-  // which takes from every order the unassigned candidate nearest the seed within that window; repeat. Windows
-  // cannot chain neighbouring modes together, and a cluster holds at most one pole per order.
-  std::sort(cand.begin(), cand.end(), [&](int a, int b) { return s.poles[a].frequency_hz < s.poles[b].frequency_hz; });
-  std::vector<char> used(cand.size(), 0);
-  std::vector<std::vector<int>> clusters;
-  const double tol = o.cluster_tolerance;
-  std::vector<double> fc(cand.size());
-  for (std::size_t a = 0; a < cand.size(); ++a) fc[a] = s.poles[cand[a]].frequency_hz;
-  std::vector<int> prefix(cand.size() + 1);
-  for (;;) {
-    // Unused candidates within +-tol of each one, by prefix sums over the sorted frequencies (two pointers).
-    for (std::size_t a = 0; a < cand.size(); ++a) prefix[a + 1] = prefix[a] + (used[a] ? 0 : 1);
-    int seed = -1, best = 0;
-    std::size_t lo = 0, hi = 0;
-    for (std::size_t a = 0; a < cand.size(); ++a) {
-      while (fc[lo] < fc[a] * (1 - tol)) ++lo;
-      while (hi < cand.size() && fc[hi] <= fc[a] * (1 + tol)) ++hi;
-      const int count = prefix[hi] - prefix[lo];
-      if (!used[a] && count > best) best = count, seed = static_cast<int>(a);
-    }
-    if (seed < 0) break;
-    const double f0 = fc[seed];
-    std::size_t w0 = static_cast<std::size_t>(seed), w1 = static_cast<std::size_t>(seed) + 1;
-    while (w0 > 0 && fc[w0 - 1] >= f0 * (1 - tol)) --w0;
-    while (w1 < cand.size() && fc[w1] <= f0 * (1 + tol)) ++w1;
-    std::map<int, std::size_t> nearest;  // order -> candidate nearest the seed
-    for (std::size_t b = w0; b < w1; ++b) {
-      if (used[b]) continue;
-      const int ord = s.poles[cand[b]].order;
-      auto it = nearest.find(ord);
-      if (it == nearest.end() || std::abs(fc[b] - f0) < std::abs(fc[it->second] - f0)) nearest[ord] = b;
-    }
-    std::vector<int> members;
-    for (const auto& [ord, b] : nearest) used[b] = 1, members.push_back(cand[b]);
-    used[seed] = 1;
-    if (std::find(members.begin(), members.end(), cand[seed]) == members.end()) members.push_back(cand[seed]);
-    clusters.push_back(members);
-  }
-  std::sort(clusters.begin(), clusters.end(), [&](const std::vector<int>& a, const std::vector<int>& b) {
-    return s.poles[a[0]].frequency_hz < s.poles[b[0]].frequency_hz;
-  });
-  const double needed = o.min_cluster_fraction * static_cast<double>(orders.size());
-  std::vector<std::pair<int, int>> chosen;
-  for (const std::vector<int>& c : clusters) {
-    std::vector<int> ords;
-    std::vector<double> f, z;
-    for (int i : c) {
-      ords.push_back(s.poles[i].order);
-      f.push_back(s.poles[i].frequency_hz);
-      z.push_back(s.poles[i].damping_ratio);
-    }
-    std::sort(ords.begin(), ords.end());
-    const int distinct = static_cast<int>(std::unique(ords.begin(), ords.end()) - ords.begin());
-    if (distinct < needed) continue;
-    IdentifiedMode m;
-    m.frequency_hz = median(f);
-    m.damping_ratio = median(z);
-    m.frequency_std_hz = stddev(f);
-    m.damping_std = stddev(z);
-    m.poles = distinct;
-    int rep = c[0];
-    for (int i : c)
-      if (std::abs(s.poles[i].frequency_hz - m.frequency_hz) < std::abs(s.poles[rep].frequency_hz - m.frequency_hz)) rep = i;
-    for (int i : c) s.poles[i].cluster = static_cast<int>(s.modes.size());
-    s.modes.push_back(m);
-    chosen.push_back(where[rep]);
-  }
-  return chosen;
 }
 
 // Marks modes whose shape repeats a stronger one's nearby (split pairs / duplicates).
@@ -196,6 +73,36 @@ Eigen::MatrixXcd lsfd(const Eigen::VectorXd& w, const Eigen::MatrixXcd& H, const
   for (Eigen::Index r = 0; r < nm; ++r)
     for (Eigen::Index c = 0; c < H.cols(); ++c)
       R(r, c) = {scale[2 * r] * x(2 * r, c), scale[2 * r + 1] * x(2 * r + 1, c)};
+  return R;
+}
+
+// Residues of every FRF column at one pole from the lines around it alone (a local LSFD: the pole's pair and a
+// complex constant plus slope for everything else). For judging a cluster: near-duplicate poles of one mode do
+// not share (and scramble) one residue as they would in a joint fit. Returns one residue per column.
+Eigen::VectorXcd local_residues(const Eigen::VectorXd& w, const Eigen::MatrixXcd& H, std::complex<double> pole, double half_width) {
+  const Eigen::Index nf = w.size();
+  const double wr = pole.imag();
+  Eigen::Index a = std::lower_bound(w.data(), w.data() + nf, wr - half_width) - w.data();
+  Eigen::Index b = std::upper_bound(w.data(), w.data() + nf, wr + half_width) - w.data();
+  while (b - a < 8 && (a > 0 || b < nf)) {
+    if (a > 0) --a;
+    if (b < nf) ++b;
+  }
+  const Eigen::Index n = b - a;
+  const std::complex<double> I(0, 1);
+  Eigen::MatrixXcd B(n, 6);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const std::complex<double> sk = I * w[a + k], p = 1.0 / (sk - pole), q = 1.0 / (sk - std::conj(pole));
+    const double x = (w[a + k] - wr) / std::max(half_width, 1e-300);
+    B.row(k) << p + q, I * p - I * q, 1.0, I, x, I * x;
+  }
+  Eigen::MatrixXd A(2 * n, 6), rhs(2 * n, H.cols());
+  A << B.real(), B.imag();
+  rhs << H.middleRows(a, n).real(), H.middleRows(a, n).imag();
+  const Eigen::VectorXd scale = A.colwise().norm().cwiseMax(1e-300).cwiseInverse();
+  const Eigen::MatrixXd x = (A * scale.asDiagonal()).colPivHouseholderQr().solve(rhs);
+  Eigen::VectorXcd R(H.cols());
+  for (Eigen::Index c = 0; c < H.cols(); ++c) R[c] = {scale[0] * x(0, c), scale[1] * x(1, c)};
   return R;
 }
 
@@ -247,7 +154,23 @@ bool IdentificationOptions::IsValid(std::string* why) const {
   if (!(min_cluster_fraction > 0 && min_cluster_fraction <= 1)) return fail("the cluster fraction must be in (0, 1]");
   if (!(cluster_tolerance > 0 && cluster_tolerance < 0.5)) return fail("the cluster tolerance must be in (0, 0.5)");
   if (block_rows < 0 || decimate < 0) return fail("block rows and decimation must be >= 0");
+  if (!(min_mpc >= 0 && min_mpc <= 1)) return fail("the MPC limit must be in [0, 1]");
+  if (!(trough_db >= 0)) return fail("the indicator trough limit must be >= 0 dB");
+  if (!(merge_tolerance >= 0 && merge_tolerance < 0.5) || !(merge_mac > 0 && merge_mac <= 1))
+    return fail("the merge tolerance must be in [0, 0.5) and the merge MAC in (0, 1]");
+  if (segment < -1 || (segment > 0 && segment < 8)) return fail("the segment must be -1 (automatic), 0 (whole records) or >= 8 samples");
+  if (!(exponential_end >= 0 && exponential_end < 1)) return fail("the exponential window end must be in [0, 1)");
   return true;
+}
+
+const char* to_string(Rejection r) {
+  switch (r) {
+    case Rejection::kFewOrders: return "few orders";
+    case Rejection::kComplexShape: return "complex shape";
+    case Rejection::kIndicatorTrough: return "indicator trough";
+    case Rejection::kSplit: return "split";
+  }
+  return "?";
 }
 
 std::vector<SpectrumPeak> spectrum_peaks(const Eigen::VectorXd& f, const Eigen::VectorXd& db, double lo, double hi, double min_prom) {
@@ -308,6 +231,7 @@ ModalData IdentificationSummary::modal_data(const std::string& source) const {
   d.mpc.resize(n);
   d.frequency_std_hz.resize(n);
   d.damping_std.resize(n);
+  if (uncertainty_halves > 0) d.shape_std.resize(n);
   d.shapes.resize(static_cast<Eigen::Index>(dofs.size()), n);
   for (Eigen::Index k = 0; k < n; ++k) {
     const IdentifiedMode& m = modes[static_cast<std::size_t>(k)];
@@ -316,6 +240,7 @@ ModalData IdentificationSummary::modal_data(const std::string& source) const {
     d.mpc[k] = m.mpc;
     d.frequency_std_hz[k] = m.frequency_std_hz;
     d.damping_std[k] = m.damping_std;
+    if (uncertainty_halves > 0) d.shape_std[k] = m.shape_std;
     d.shapes.col(k) = m.real_shape;
   }
   return d;
@@ -354,9 +279,19 @@ IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationO
     w[k] = 2 * kPi * frf.frequency_hz[lines[k]];
     H.row(k) = frf.H.row(lines[k]);
   }
+  s.band_lo_hz = lo;
+  s.band_hi_hz = hi;
+  s.resolution_hz = frf_in.frequency_hz.size() > 1 ? (frf_in.frequency_hz[frf_in.frequency_hz.size() - 1] - frf_in.frequency_hz[0]) / static_cast<double>(frf_in.frequency_hz.size() - 1) : 0;
+  // CMIF: the first singular value of the outputs x inputs FRF matrix at every line.
   s.frequency_hz = frf_in.frequency_hz;
-  s.background = frf_in.H.cwiseAbs().rowwise().sum();
-  s.background_label = "sum of |H|";
+  s.background.resize(frf_in.frequency_hz.size());
+  for (Eigen::Index k = 0; k < frf_in.frequency_hz.size(); ++k) {
+    Eigen::MatrixXcd Hk(no, ni);
+    for (int i = 0; i < ni; ++i)
+      for (int oo = 0; oo < no; ++oo) Hk(oo, i) = frf_in.H(k, oo + i * no);
+    s.background[k] = ni == 1 ? Hk.norm() : Eigen::JacobiSVD<Eigen::MatrixXcd>(Hk).singularValues()[0];
+  }
+  s.background_label = "CMIF (first singular value of the FRFs)";
 
   // Basis z^r on the unit circle, dt = 1 / (2 f_top). The normal-equation blocks are Toeplitz in the degree:
   //   R[r, s] = Re c(s - r),  S_o[r, (s, j)] = -Re h_oj(s - r),  T_o[(r, i), (s, j)] = Re g_oij(s - r),
@@ -426,21 +361,52 @@ IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationO
     orders.push_back(std::move(poles));
     order_of.push_back(p);
   }
-  const std::vector<std::pair<int, int>> chosen = stabilize_and_select(orders, order_of, lo, hi, o, s);
-  if (!chosen.empty()) {
-    // LSFD at the selected poles of the windowed data (the window's decay put back).
-    std::vector<std::complex<double>> poles;
-    for (const auto& [j, p] : chosen) poles.push_back(orders[j][p].lambda - frf.window_decay);
+  // Selection: clusters, shapes of those with support (LSFD at all of them), evidence, then LSFD at the modes.
+  const std::vector<PoleCluster> clusters = internal::stabilize_and_cluster(orders, order_of, lo, hi, o, s);
+  auto residues = [&](const std::vector<std::complex<double>>& poles) {
+    // Per pole, the outputs x inputs residue matrix of the receptance.
+    std::vector<Eigen::MatrixXcd> out;
+    if (poles.empty()) return out;
     const Eigen::MatrixXcd res = lsfd(w, H, poles);
-    double top = 0;
-    for (std::size_t r = 0; r < s.modes.size(); ++r) {
+    for (std::size_t r = 0; r < poles.size(); ++r) {
       Eigen::MatrixXcd Rr(no, ni);
       for (int i = 0; i < ni; ++i)
         for (int oo = 0; oo < no; ++oo) Rr(oo, i) = res(static_cast<Eigen::Index>(r), oo + i * no);
-      Eigen::JacobiSVD<Eigen::MatrixXcd> svd(Rr, Eigen::ComputeThinU);
-      s.modes[r].shape = svd.matrixU().col(0) * svd.singularValues()[0];
+      out.push_back(Rr);
+    }
+    return out;
+  };
+  auto principal = [](const Eigen::MatrixXcd& Rr) -> Eigen::VectorXcd {
+    Eigen::JacobiSVD<Eigen::MatrixXcd> svd(Rr, Eigen::ComputeThinU);
+    return svd.matrixU().col(0) * svd.singularValues()[0];
+  };
+  std::vector<Candidate> cands(clusters.size());
+  std::vector<double> peak(clusters.size(), 0.0);
+  for (std::size_t c = 0; c < clusters.size(); ++c) {
+    cands[c].cluster = clusters[c];
+    cands[c].strength = clusters[c].support;
+    // The windowed data's peaks are wider by the window's decay.
+    const double zw = clusters[c].damping_ratio + frf.window_decay / (2 * kPi * clusters[c].frequency_hz);
+    peak[c] = internal::indicator_peakness(s.frequency_hz, s.background.cwiseAbs2(), clusters[c].frequency_hz, zw);
+    if (clusters[c].support < internal::kShapedShare * o.min_cluster_fraction) continue;
+    const std::complex<double> pw = internal::pole_of(clusters[c].frequency_hz, clusters[c].damping_ratio) - frf.window_decay;
+    const Eigen::VectorXcd R = local_residues(w, H, pw, std::max(3 * zw * std::abs(pw), 5 * 2 * kPi * s.resolution_hz));
+    Eigen::MatrixXcd Rr(no, ni);
+    for (int i = 0; i < ni; ++i)
+      for (int oo = 0; oo < no; ++oo) Rr(oo, i) = R[oo + i * no];
+    cands[c].shape = principal(Rr);
+  }
+  internal::make_modes(cands, peak, internal::check_evidence(cands, peak, o, orders.size(), s), orders.size(), s);
+  if (!s.modes.empty()) {
+    // LSFD at the modes' poles of the windowed data (the window's decay put back).
+    std::vector<std::complex<double>> poles;
+    for (const IdentifiedMode& m : s.modes) poles.push_back(internal::pole_of(m.frequency_hz, m.damping_ratio) - frf.window_decay);
+    const std::vector<Eigen::MatrixXcd> res = residues(poles);
+    double top = 0;
+    for (std::size_t r = 0; r < s.modes.size(); ++r) {
+      s.modes[r].shape = principal(res[r]);
       finish_shape(s.modes[r]);
-      s.modes[r].contribution = Rr.norm() / std::abs(poles[r].real());
+      s.modes[r].contribution = res[r].norm() / std::abs(poles[r].real());
       top = std::max(top, s.modes[r].contribution);
     }
     for (IdentifiedMode& m : s.modes) m.contribution = top > 0 ? m.contribution / top : 0;
@@ -530,23 +496,49 @@ IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOpt
     orders.push_back(std::move(poles));
     order_of.push_back(n);
   }
-  const std::vector<std::pair<int, int>> chosen = stabilize_and_select(orders, order_of, lo, hi, o, s);
-  for (std::size_t r = 0; r < chosen.size(); ++r) {
-    s.modes[r].shape = orders[chosen[r].first][chosen[r].second].vec;
-    finish_shape(s.modes[r]);
-  }
-  mark_twins(s.modes, false);
-  // Background: first singular value of the output cross-spectral matrix.
+  // Background and mode indicator: first singular value of the output cross-spectral matrix.
   WelchOptions wo;
   int seg = 8;
   const Eigen::Index shortest = std::min_element(decimated.begin(), decimated.end(), [](const auto& a, const auto& b) { return a.rows() < b.rows(); })->rows();
-  while (seg * 2 <= shortest && seg < 8 * fs / flow && seg < (1 << 16)) seg *= 2;
+  if (o.segment > 0) {  // the plan's resolution, in decimated samples
+    while (seg * 2 <= shortest && seg * 2 <= o.segment / dec) seg *= 2;
+  } else {
+    while (seg * 2 <= shortest && seg < 8 * fs / flow && seg < (1 << 16)) seg *= 2;
+  }
   wo.segment = seg;
   const CrossSpectra G = welch(decimated, fs, wo);
   s.frequency_hz = G.frequency;
+  s.resolution_hz = fs / seg;
+  s.band_lo_hz = lo;
+  s.band_hi_hz = hi;
   s.background.resize(G.frequency.size());
   for (Eigen::Index k = 0; k < G.frequency.size(); ++k)
     s.background[k] = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXcd>(G.G[k], Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+  // Selection: clusters; a cluster's shape is the weighted mean of its poles' shapes (each turned to the
+  // strongest member's phase); evidence.
+  const std::vector<PoleCluster> clusters = internal::stabilize_and_cluster(orders, order_of, lo, hi, o, s);
+  std::vector<Candidate> cands(clusters.size());
+  std::vector<double> peak(clusters.size(), 0.0);
+  for (std::size_t c = 0; c < clusters.size(); ++c) {
+    const PoleCluster& pc = clusters[c];
+    cands[c].cluster = pc;
+    cands[c].strength = pc.support;
+    peak[c] = internal::indicator_peakness(s.frequency_hz, s.background, pc.frequency_hz, pc.damping_ratio);
+    if (pc.support < internal::kShapedShare * o.min_cluster_fraction) continue;
+    const std::size_t top = static_cast<std::size_t>(std::max_element(pc.member_weight.begin(), pc.member_weight.end()) - pc.member_weight.begin());
+    const Eigen::VectorXcd ref = orders[pc.members[top].first][pc.members[top].second].vec.normalized();
+    Eigen::VectorXcd sum = Eigen::VectorXcd::Zero(ref.size());
+    for (std::size_t m = 0; m < pc.members.size(); ++m) {
+      Eigen::VectorXcd v = orders[pc.members[m].first][pc.members[m].second].vec.normalized();
+      const std::complex<double> d = ref.dot(v);  // conj(ref) . v
+      if (std::abs(d) > 0) v *= std::conj(d) / std::abs(d);
+      sum += pc.member_weight[m] * v;
+    }
+    cands[c].shape = sum;
+  }
+  internal::make_modes(cands, peak, internal::check_evidence(cands, peak, o, orders.size(), s), orders.size(), s);
+  for (IdentifiedMode& m : s.modes) finish_shape(m);
+  mark_twins(s.modes, false);
   s.background_label = "first singular value of the output spectral matrix";
   s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return s;

@@ -1,9 +1,12 @@
-// Identification of recordings as a whole (used by discovery and by host codes): FRFs + LSCF, or SSI-cov.
+// Identification of recordings as a whole (used by dynid identify, discovery and host codes): the plan (band and
+// resolution from the data), FRFs + LSCF or SSI-cov, and the split-data uncertainty.
 #include <algorithm>
+#include <cmath>
 
 #include "dynid/engine/frf.hpp"
 #include "dynid/engine/identify.hpp"
 #include "dynid/mesh/error.hpp"
+#include "internal/identify_select.hpp"
 
 namespace dynid {
 
@@ -33,25 +36,175 @@ FrfData merge_frfs(std::vector<FrfData> sets) {
   return out;
 }
 
-IdentificationSummary identify_recordings(std::vector<Recording> recs, const std::string& method_in,
-                                          const IdentificationOptions& io) {
-  if (recs.empty()) throw InputError("identify: no recordings");
-  bool has_inputs = false;
-  for (const Recording& r : recs) has_inputs = has_inputs || !r.input_channels().empty();
-  const std::string method = method_in.empty() ? (has_inputs ? "lscf" : "ssi") : method_in;
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string fmt(const char* f, double a, double b = 0, double c = 0) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, f, a, b, c);
+  return buf;
+}
+
+// The half of a mode in a half-data identification: within max(5 %, 3 zeta) in frequency, the best MAC >= 0.8.
+const IdentifiedMode* partner(const IdentifiedMode& m, const IdentificationSummary& half) {
+  const IdentifiedMode* best = nullptr;
+  double best_mac = 0.8;
+  const Eigen::VectorXcd a = m.real_shape.cast<std::complex<double>>();
+  for (const IdentifiedMode& h : half.modes) {
+    if (std::abs(h.frequency_hz - m.frequency_hz) > std::max(0.05, 3 * m.damping_ratio) * m.frequency_hz) continue;
+    const double mac = internal::complex_mac(a, h.real_shape.cast<std::complex<double>>());
+    if (mac >= best_mac) best_mac = mac, best = &h;
+  }
+  return best;
+}
+
+// Split-data uncertainty (identify.hpp, header comment) from the identifications of the two halves.
+void split_uncertainty(IdentificationSummary& s, const IdentificationSummary& A, const IdentificationSummary& B) {
+  const std::size_t n = s.modes.size();
+  std::vector<double> ef(n, -1), ez(n, -1), es(n, -1);
+  std::vector<double> pf, pz, ps;
+  for (std::size_t k = 0; k < n; ++k) {
+    const IdentifiedMode& m = s.modes[k];
+    const IdentifiedMode* a = partner(m, A);
+    const IdentifiedMode* b = partner(m, B);
+    if (!a || !b) continue;
+    const double zeta = std::max(m.damping_ratio, 1e-4);
+    ef[k] = std::abs(a->frequency_hz - b->frequency_hz) / (2 * m.frequency_hz * zeta);
+    ez[k] = std::abs(a->damping_ratio - b->damping_ratio) / (2 * zeta);
+    Eigen::VectorXd ua = a->real_shape, ub = b->real_shape;  // max |.| = 1 each
+    if (ua.dot(ub) < 0) ub = -ub;
+    es[k] = std::sqrt((ua - ub).squaredNorm() / static_cast<double>(ua.size())) / 2;
+    pf.push_back(ef[k]), pz.push_back(ez[k]), ps.push_back(es[k]);
+  }
+  if (pf.empty()) {
+    s.notes.push_back("split-data uncertainty: no mode was found in both halves of the data; the spread over model orders is reported");
+    return;
+  }
+  const double kMad = 0.6745;  // median of |N(0, 1)|
+  const double pool_f = median(pf) / kMad, pool_z = median(pz) / kMad, pool_s = median(ps) / kMad;
+  s.uncertainty_halves = 2;
+  s.pooled_frequency_std = pool_f;
+  s.pooled_shape_std = pool_s;
+  int own = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    IdentifiedMode& m = s.modes[k];
+    const double zeta = std::max(m.damping_ratio, 1e-4);
+    m.frequency_std_hz = m.frequency_hz * zeta * std::max(ef[k], pool_f);
+    m.damping_std = zeta * std::max(ez[k], pool_z);
+    m.shape_std = std::max(es[k], pool_s);
+    own += ef[k] >= 0;
+  }
+  s.notes.push_back(fmt("split-data uncertainty: %.0f of %.0f modes found in both halves of the data; ", own, static_cast<double>(n)) +
+                    fmt("pooled sigma_f = %.3g x f zeta, shape std %.3g of the largest entry", pool_f, pool_s));
+}
+
+// The two halves of the data: alternate records of every recording when each has two or more, else the two
+// halves in time of each record (continuous data). Empty when the data cannot be split (one impact).
+bool halves_of(const std::vector<Recording>& recs, bool impulsive, std::vector<Recording>* A, std::vector<Recording>* B, std::string* how) {
+  bool by_records = true;
+  for (const Recording& r : recs) by_records = by_records && r.records.size() >= 2;
+  if (!by_records && impulsive) return false;
+  for (const Recording& r : recs) {
+    Recording a = r, b = r;
+    a.records.clear(), b.records.clear();
+    for (std::size_t k = 0; k < r.records.size(); ++k) {
+      if (by_records) {
+        (k % 2 ? b : a).records.push_back(r.records[k]);
+      } else {
+        const Eigen::Index h = r.records[k].rows() / 2;
+        a.records.push_back(r.records[k].topRows(h));
+        b.records.push_back(r.records[k].middleRows(h, h));
+      }
+    }
+    A->push_back(std::move(a));
+    B->push_back(std::move(b));
+  }
+  *how = by_records ? "alternate records" : "the two halves in time";
+  return true;
+}
+
+IdentificationSummary identify_once(const std::vector<Recording>& recs, const std::string& method, const IdentificationOptions& io,
+                                    const IdentificationPlan& plan) {
   if (method == "lscf") {
-    if (!has_inputs) throw InputError("identify: LSCF needs recordings with a force channel; these are output-only: use ssi");
     FrfOptions fo;
-    if (io.band_hi_hz > 0) fo.max_frequency_hz = std::min(1.25 * io.band_hi_hz, recs[0].sample_rate_hz / 2);
+    fo.estimator = io.estimator;
+    fo.exponential_end = plan.impulsive ? io.exponential_end : 0;
+    fo.segment = plan.impulsive ? 0 : plan.segment;
+    fo.max_frequency_hz = std::min(1.25 * io.band_hi_hz, recs[0].sample_rate_hz / 2);
     return identify_lscf(estimate_frf(recs, fo), io);
   }
-  if (method != "ssi") throw InputError("identify: unknown method '" + method + "' (lscf or ssi)");
+  Recording all = recs[0];
   for (std::size_t k = 1; k < recs.size(); ++k) {
     if (recs[k].sample_rate_hz != recs[0].sample_rate_hz || recs[k].num_channels() != recs[0].num_channels())
       throw InputError("identify: recordings identified together need the same channels and sampling rate (" + recs[k].source + ")");
-    recs[0].records.insert(recs[0].records.end(), recs[k].records.begin(), recs[k].records.end());
+    all.records.insert(all.records.end(), recs[k].records.begin(), recs[k].records.end());
   }
-  return identify_ssi(recs[0], io);
+  return identify_ssi(all, io);
+}
+
+}  // namespace
+
+IdentificationSummary identify_frfs(const FrfData& frf, const IdentificationOptions& io_in, const std::vector<FrfData>& halves) {
+  const IdentificationPlan plan = plan_identification(frf, io_in);
+  IdentificationOptions io = io_in;
+  io.band_lo_hz = plan.band_lo_hz;
+  io.band_hi_hz = plan.band_hi_hz;
+  IdentificationSummary s = identify_lscf(frf, io);
+  s.band_from_data = plan.band_from_data;
+  s.notes.insert(s.notes.begin(), plan.notes.begin(), plan.notes.end());
+  if (io.split_uncertainty && halves.size() == 2 && !s.modes.empty()) {
+    IdentificationOptions h = io;
+    h.band_lo_hz = s.band_lo_hz, h.band_hi_hz = s.band_hi_hz;
+    split_uncertainty(s, identify_lscf(halves[0], h), identify_lscf(halves[1], h));
+  }
+  return s;
+}
+
+IdentificationSummary identify_recordings(std::vector<Recording> recs, const std::string& method_in, const IdentificationOptions& io_in) {
+  if (recs.empty()) throw InputError("identify: no recordings");
+  std::string why;
+  if (!io_in.IsValid(&why)) throw InputError("identify: " + why);
+  for (const Recording& r : recs) r.validate("identify: " + r.source);
+  bool has_inputs = false;
+  for (const Recording& r : recs) has_inputs = has_inputs || !r.input_channels().empty();
+  const std::string method = method_in.empty() ? (has_inputs ? "lscf" : "ssi") : method_in;
+  if (method == "lscf" && !has_inputs) throw InputError("identify: LSCF needs recordings with a force channel; these are output-only: use ssi");
+  if (method != "lscf" && method != "ssi") throw InputError("identify: unknown method '" + method + "' (lscf or ssi)");
+  // The plan: band and resolution from the data where the options leave them open.
+  const IdentificationPlan plan = plan_identification(recs, io_in);
+  IdentificationOptions io = io_in;
+  io.band_lo_hz = plan.band_lo_hz;
+  io.band_hi_hz = plan.band_hi_hz;
+  if (method == "ssi" && io.segment < 0 && plan.segment > 0) io.segment = plan.segment;
+  IdentificationSummary s = identify_once(recs, method, io, plan);
+  s.band_from_data = plan.band_from_data;
+  s.notes.insert(s.notes.begin(), plan.notes.begin(), plan.notes.end());
+  if (io.split_uncertainty && !s.modes.empty()) {
+    std::vector<Recording> A, B;
+    std::string how;
+    if (!halves_of(recs, plan.impulsive, &A, &B, &how)) {
+      s.notes.push_back("split-data uncertainty: one impact cannot be split; the spread over model orders is reported");
+    } else {
+      IdentificationOptions h = io;
+      h.split_uncertainty = false;
+      IdentificationPlan hp = plan;
+      if (!plan.impulsive && how != "alternate records") hp.segment = std::max(8, plan.segment / 2);
+      try {
+        const IdentificationSummary a = identify_once(A, method, h, hp), b = identify_once(B, method, h, hp);
+        split_uncertainty(s, a, b);
+        if (s.uncertainty_halves) s.notes.back() += " (halves: " + how + ")";
+      } catch (const InputError& e) {
+        s.notes.push_back(std::string("split-data uncertainty: the halves could not be identified (") + e.what() + "); the spread over model orders is reported");
+      }
+    }
+  }
+  return s;
 }
 
 }  // namespace dynid

@@ -6,6 +6,7 @@
 #include "dynid/io/discover_io.hpp"
 #include "dynid/io/modal_data_io.hpp"
 #include "dynid/io/test_data.hpp"
+#include "dynid/io/test_layout.hpp"
 #include "dynid/io/uff.hpp"
 #include "internal/case_util.hpp"
 #include "internal/text_util.hpp"
@@ -203,12 +204,14 @@ DiscoveryData discovery_data(const Case& c, int seed_offset) {
       out.truth_modes = std::move(vt.modes);
       out.source = "virtual test of the truth model (seed " + std::to_string(d.truth_test->options.seed + static_cast<std::uint64_t>(seed_offset)) + ")";
     } else {
-      for (const std::string& f : d.recordings) {
-        TestData td = read_test_data(f);
-        if (td.kind == TestData::Kind::kUff) recs.push_back(uff_recording(td.uff));
-        else if (td.kind == TestData::Kind::kTimeHistory) recs.push_back(std::move(td.recording));
-        else throw InputError(f + ": not a time recording (UFF 58 type 1, or a time table)");
-      }
+      // Any layout (one file per channel, per test, per hit): grouped into tests (io/test_layout.hpp).
+      const TestSet set = read_test_set(d.recordings);
+      if (set.kind != TestSet::Kind::kRecordings)
+        throw InputError(d.recordings[0] + (d.recordings.size() > 1 ? " ..." : "") + ": discover: recordings: needs time recordings (UFF 58 type 1, text or LabVIEW time tables); these hold " +
+                         (set.kind == TestSet::Kind::kFrf ? "FRFs" : "a spectrum"));
+      set.require_consistent();
+      recs = set.recordings();
+      out.notes.insert(out.notes.end(), set.notes.begin(), set.notes.end());
       out.source = d.recordings[0] + (d.recordings.size() > 1 ? " ..." : "");
     }
     const std::string method = d.truth ? (d.method.empty() ? d.truth_test->method : d.method) : d.method;

@@ -13,15 +13,41 @@ nlohmann::ordered_json identification_json(const IdentificationSummary& s) {
   for (const MeasuredDof& d : s.dofs) dofs.push_back(to_string(d));
   j["dofs"] = dofs;
   j["orders"] = {s.min_order, s.max_order};
+  j["band_hz"] = {s.band_lo_hz, s.band_hi_hz};
+  j["band_from_data"] = s.band_from_data;
+  j["resolution_hz"] = s.resolution_hz;
   j["seconds"] = s.seconds;
   j["window_decay_removed"] = s.window_decay_removed;
+  if (s.uncertainty_halves > 0)
+    j["uncertainty"] = {{"halves", s.uncertainty_halves}, {"pooled_frequency_std", s.pooled_frequency_std}, {"pooled_shape_std", s.pooled_shape_std}};
   nlohmann::ordered_json modes = modal_data_json(s.modal_data(s.method))["modes"];
   for (std::size_t k = 0; k < s.modes.size(); ++k) {
-    modes[k]["contribution"] = s.modes[k].contribution;
-    modes[k]["poles"] = s.modes[k].poles;
-    if (s.modes[k].twin_of >= 0) modes[k]["same_shape_as"] = {{"mode", s.modes[k].twin_of + 1}, {"mac", s.modes[k].twin_mac}};
+    const IdentifiedMode& m = s.modes[k];
+    modes[k]["contribution"] = m.contribution;
+    modes[k]["poles"] = m.poles;
+    modes[k]["support"] = m.support;
+    modes[k]["indicator_db"] = m.indicator_db;
+    modes[k]["order_frequency_std_hz"] = m.order_frequency_std_hz;
+    if (m.twin_of >= 0) modes[k]["same_shape_as"] = {{"mode", m.twin_of + 1}, {"mac", m.twin_mac}};
   }
   j["modes"] = modes;
+  nlohmann::ordered_json rejected = nlohmann::ordered_json::array();
+  for (const RejectedCluster& r : s.rejected) {
+    nlohmann::ordered_json x;
+    x["frequency_hz"] = r.frequency_hz;
+    x["damping_ratio"] = r.damping_ratio;
+    x["poles"] = r.poles;
+    x["support"] = r.support;
+    x["reason"] = to_string(r.reason);
+    x["value"] = r.value;
+    x["limit"] = r.limit;
+    if (r.reason == Rejection::kSplit) x["merged_into"] = r.merged_into + 1;
+    rejected.push_back(x);
+  }
+  j["rejected"] = rejected;
+  nlohmann::ordered_json notes = nlohmann::ordered_json::array();
+  for (const std::string& n : s.notes) notes.push_back(n);
+  j["notes"] = notes;
   return j;
 }
 

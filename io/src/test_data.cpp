@@ -9,6 +9,7 @@
 
 #include "dynid/io/modal_data_io.hpp"
 #include "dynid/mesh/error.hpp"
+#include "dynid/solvers/signal.hpp"
 #include "internal/text_util.hpp"
 
 namespace dynid {
@@ -121,6 +122,18 @@ Channel guess_channel(const std::string& name, const std::string& unit) {
   } else if (contains(name, "disp")) {
     c.quantity = Quantity::kDisplacement;
   }
+  // A DOF label among the name's words ("5uy", "acc 5uy", "17ux force", "acc_5uy").
+  std::string words = name;
+  for (char& ch : words)
+    if (ch == '_' || ch == ',' || ch == ';' || ch == '(' || ch == ')' || ch == '[' || ch == ']') ch = ' ';
+  for (std::string_view w : split_fields(words)) {
+    MeasuredDof d;
+    double sign = 1;
+    if (parse_dof_label(std::string(w), &d, &sign) && d.node > 0 && sign > 0) {
+      c.dof = d;
+      break;
+    }
+  }
   return c;
 }
 
@@ -141,7 +154,175 @@ bool same_grid(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return true;
 }
 
+bool any_of_words(const std::string& name, std::initializer_list<const char*> words) {
+  std::string n = lower(name);
+  for (char& ch : n)
+    if (!std::isalnum(static_cast<unsigned char>(ch))) ch = ' ';
+  for (std::string_view w : split_fields(n))
+    for (const char* x : words)
+      if (w == x) return true;
+  return false;
+}
+bool starts_with_any(const std::string& name, std::initializer_list<const char*> prefixes) {
+  const std::string n = lower(std::string(trim(name)));
+  for (const char* p : prefixes)
+    if (n.rfind(p, 0) == 0) return true;
+  return false;
+}
+
+// The complex inverse DFT of re + i im (length n), from two real forward FFTs:
+// idft(x)[t] = conj(dft(conj(x)))[t] / n, dft(a - i b) = dft(a) - i dft(b), each real-input DFT completed by its
+// conjugate symmetry.
+Eigen::VectorXcd inverse_dft(const Eigen::VectorXd& re, const Eigen::VectorXd& im) {
+  const int n = static_cast<int>(re.size());
+  RealFft fft(n);
+  std::vector<std::complex<double>> A(static_cast<std::size_t>(n / 2 + 1)), B(A.size());
+  Eigen::VectorXd a = re, b = im;
+  fft.forward(a.data(), A.data());
+  fft.forward(b.data(), B.data());
+  auto full = [&](const std::vector<std::complex<double>>& X, int k) { return k <= n / 2 ? X[static_cast<std::size_t>(k)] : std::conj(X[static_cast<std::size_t>(n - k)]); };
+  Eigen::VectorXcd out(n);
+  for (int k = 0; k < n; ++k) out[k] = std::conj(full(A, k) - std::complex<double>(0, 1) * full(B, k)) / static_cast<double>(n);
+  return out;
+}
+
 }  // namespace
+
+const char* to_string(TableKind k) {
+  switch (k) {
+    case TableKind::kTimeHistory: return "time history";
+    case TableKind::kFrf: return "FRF";
+    case TableKind::kSpectrum: return "spectrum";
+    case TableKind::kAuto: return "auto";
+  }
+  return "?";
+}
+
+double frf_causality(const Eigen::VectorXd& re, const Eigen::VectorXd& im) {
+  if (re.size() != im.size() || re.size() < 8) return 0;
+  // (i k)^p H for p = 0, 1, 2 (receptance, mobility, accelerance up to a scale of the lines): causal whatever
+  // the response quantity, and one of them keeps a measured FRF's low-frequency blow-up (receptance from
+  // accelerance) or high-frequency noise from swamping the rest.
+  double best = 0;
+  for (int p = 0; p <= 2; ++p) {
+    Eigen::VectorXd a(re.size()), b(re.size());
+    for (Eigen::Index k = 0; k < re.size(); ++k) {
+      const std::complex<double> z = std::complex<double>(re[k], im[k]) * std::pow(std::complex<double>(0, static_cast<double>(k)), p);
+      a[k] = z.real(), b[k] = z.imag();
+    }
+    const Eigen::VectorXcd g = inverse_dft(a, b);
+    const Eigen::Index n = g.size(), half = n / 2;
+    double ep = 0, em = 0;
+    for (Eigen::Index t = 1; t < half; ++t) ep += std::norm(g[t]), em += std::norm(g[n - t]);
+    if (ep + em > 0) best = std::max(best, std::abs(ep - em) / (ep + em));
+  }
+  return best;
+}
+
+TableKind classify_text_table(const TextTable& t, std::string* why) {
+  auto say = [&](TableKind k, const std::string& w) {
+    if (why) *why = w;
+    return k;
+  };
+  const Eigen::Index nc = t.columns.cols();
+  // 1. The header, when it names the columns.
+  bool re_im = nc >= 2 && nc % 2 == 0;
+  for (Eigen::Index c = 0; re_im && c < nc; ++c) {
+    const std::string& nm = t.names[static_cast<std::size_t>(c)];
+    re_im = c % 2 == 0 ? starts_with_any(nm, {"re", "real"}) : starts_with_any(nm, {"im", "imag"});
+  }
+  bool spectral_names = false;
+  for (const std::string& nm : t.names) spectral_names = spectral_names || contains(nm, "fft") || contains(nm, "spectrum") || contains(nm, "psd") || any_of_words(nm, {"db", "magnitude", "mag", "amplitude"});
+  const bool time_axis = any_of_words(t.x_name, {"time", "t", "s", "sec", "seconds"});
+  const bool freq_axis = starts_with_any(t.x_name, {"freq"}) || any_of_words(t.x_name, {"hz", "f"});
+  if (re_im && !time_axis) return say(TableKind::kFrf, "the header names real and imaginary columns");
+  if (spectral_names && !time_axis) return say(TableKind::kSpectrum, "the header names a spectrum");
+  if (time_axis) return say(TableKind::kTimeHistory, "the first column is named '" + t.x_name + "' (time)");
+  // 2. Numbers: (re, im) pairs of one causal function.
+  if (nc >= 2 && nc % 2 == 0 && t.x.size() >= 16 && t.x[0] >= 0) {
+    double worst = 1;
+    for (Eigen::Index c = 0; c < nc; c += 2) worst = std::min(worst, frf_causality(t.columns.col(c), t.columns.col(c + 1)));
+    if (worst >= 0.5)
+      return say(TableKind::kFrf, "columns 2 and 3 are the real and imaginary parts of one causal function (causality " +
+                                      std::to_string(worst).substr(0, 4) + " >= 0.5)" + (freq_axis ? "" : ", read as an FRF"));
+  }
+  // 3. One-signed columns: magnitudes or levels, not a signal about zero.
+  bool one_signed = nc >= 1;
+  for (Eigen::Index c = 0; c < nc && one_signed; ++c) one_signed = t.columns.col(c).minCoeff() >= 0 || t.columns.col(c).maxCoeff() <= 0;
+  if (one_signed) return say(TableKind::kSpectrum, "every data column keeps one sign (magnitudes or dB levels, not a vibration signal)");
+  if (freq_axis) return say(TableKind::kSpectrum, "the first column is named '" + t.x_name + "' (frequency)");
+  return say(TableKind::kTimeHistory, "columns that change sign and are not real/imaginary pairs: time histories");
+}
+
+FrfData frf_of_tables(const std::vector<TextTable>& tables, const std::vector<MeasuredDof>& outputs, const std::vector<MeasuredDof>& inputs) {
+  if (tables.empty()) throw InputError("FRF text files: none given");
+  std::size_t total = 0;
+  for (const TextTable& t : tables) {
+    if (t.columns.cols() < 2 || t.columns.cols() % 2 != 0)
+      throw InputError(t.source + ": expected columns frequency, then real and imaginary parts (an odd number of columns), found " +
+                       std::to_string(t.columns.cols() + 1));
+    total += static_cast<std::size_t>(t.columns.cols() / 2);
+  }
+  auto dof_at = [&](const std::vector<MeasuredDof>& l, std::size_t k, const char* what) {
+    if (l.size() == 1) return l[0];
+    if (l.size() != total)
+      throw InputError("FRF text files: " + std::to_string(total) + " FRFs need as many " + what + " DOFs (or one for all); got " + std::to_string(l.size()));
+    return l[k];
+  };
+  FrfData h;
+  h.source = tables[0].source + (tables.size() > 1 ? " and " + std::to_string(tables.size() - 1) + " more" : "");
+  auto index_of = [](std::vector<Channel>& list, const MeasuredDof& d, bool input) {
+    for (std::size_t k = 0; k < list.size(); ++k)
+      if (list[k].dof == d) return static_cast<int>(k);
+    Channel c;
+    c.dof = d;
+    c.name = to_string(d);
+    c.input = input;
+    c.quantity = input ? Quantity::kForce : Quantity::kOther;
+    list.push_back(c);
+    return static_cast<int>(list.size()) - 1;
+  };
+  struct Pair {
+    int o, i;
+    std::size_t table;
+    Eigen::Index col;
+    MeasuredDof od, id;
+  };
+  std::vector<Pair> pairs;
+  std::size_t k = 0;
+  for (std::size_t t = 0; t < tables.size(); ++t) {
+    if (t > 0 && !same_grid(tables[0].x, tables[t].x))
+      throw InputError(tables[t].source + ": its frequencies (" + std::to_string(tables[t].x.size()) + " lines) differ from those of " +
+                       tables[0].source + " (" + std::to_string(tables[0].x.size()) + " lines); FRFs identified together need one grid");
+    for (Eigen::Index c = 0; c < tables[t].columns.cols(); c += 2, ++k) {
+      const MeasuredDof od = dof_at(outputs, k, "output"), id = dof_at(inputs, k, "input");
+      pairs.push_back({index_of(h.outputs, od, false), index_of(h.inputs, id, true), t, c, od, id});
+    }
+  }
+  const int no = h.num_outputs(), ni = h.num_inputs();
+  h.frequency_hz = tables[0].x;
+  h.H.setZero(h.frequency_hz.size(), no * ni);
+  std::vector<int> from(static_cast<std::size_t>(no * ni), -1);
+  for (std::size_t p = 0; p < pairs.size(); ++p) {
+    const Pair& q = pairs[p];
+    const int col = q.o + q.i * no;
+    if (from[static_cast<std::size_t>(col)] >= 0)
+      throw InputError(tables[q.table].source + ": FRF " + to_string(q.od) + "/" + to_string(q.id) + " already read from " +
+                       tables[pairs[static_cast<std::size_t>(from[static_cast<std::size_t>(col)])].table].source +
+                       " (give each FRF its own output/input DOFs)");
+    from[static_cast<std::size_t>(col)] = static_cast<int>(p);
+    h.H.col(col).real() = tables[q.table].columns.col(q.col);
+    h.H.col(col).imag() = tables[q.table].columns.col(q.col + 1);
+  }
+  std::string missing;
+  for (int i = 0; i < ni; ++i)
+    for (int o = 0; o < no; ++o)
+      if (from[static_cast<std::size_t>(o + i * no)] < 0)
+        missing += (missing.empty() ? "" : ", ") + to_string(h.outputs[o].dof) + "/" + to_string(h.inputs[i].dof);
+  if (!missing.empty()) throw InputError(h.source + ": missing FRFs for output/input pairs " + missing);
+  h.validate(h.source);
+  return h;
+}
 
 TextTable parse_text_table(const std::string& text, const std::string& name, bool x_column) {
   return to_table(parse_rows(text, name), name, x_column);
@@ -182,53 +363,13 @@ FrfData read_frf_text_set(const std::vector<std::string>& paths, const std::vect
   if (outputs.size() != paths.size() || inputs.size() != paths.size())
     throw InputError("FRF text files: " + std::to_string(paths.size()) + " files need as many output and input DOFs (got " +
                      std::to_string(outputs.size()) + " and " + std::to_string(inputs.size()) + ")");
-  FrfData h;
-  h.source = paths[0] + (paths.size() > 1 ? " and " + std::to_string(paths.size() - 1) + " more" : "");
-  auto index_of = [](std::vector<Channel>& list, const MeasuredDof& d, bool input) {
-    for (std::size_t k = 0; k < list.size(); ++k)
-      if (list[k].dof == d) return static_cast<int>(k);
-    Channel c;
-    c.dof = d;
-    c.name = to_string(d);
-    c.input = input;
-    c.quantity = input ? Quantity::kForce : Quantity::kOther;
-    list.push_back(c);
-    return static_cast<int>(list.size()) - 1;
-  };
-  std::vector<std::pair<int, int>> pair_of;
   std::vector<TextTable> tables;
-  for (std::size_t k = 0; k < paths.size(); ++k) {
-    TextTable t = read_text_table(paths[k], true);
-    if (t.columns.cols() != 2)
-      throw InputError(paths[k] + ": expected 3 columns (frequency, real, imaginary), found " +
-                       std::to_string(t.columns.cols() + 1));
-    if (k > 0 && !same_grid(tables[0].x, t.x))
-      throw InputError(paths[k] + ": its frequencies (" + std::to_string(t.x.size()) + " lines) differ from those of " +
-                       paths[0] + " (" + std::to_string(tables[0].x.size()) + " lines)");
-    pair_of.emplace_back(index_of(h.outputs, outputs[k], false), index_of(h.inputs, inputs[k], true));
-    tables.push_back(std::move(t));
+  for (const std::string& p : paths) {
+    tables.push_back(read_text_table(p, true));
+    if (tables.back().columns.cols() != 2)
+      throw InputError(p + ": expected 3 columns (frequency, real, imaginary), found " + std::to_string(tables.back().columns.cols() + 1));
   }
-  const int no = h.num_outputs(), ni = h.num_inputs();
-  h.frequency_hz = tables[0].x;
-  h.H.setZero(h.frequency_hz.size(), no * ni);
-  std::vector<int> from(static_cast<std::size_t>(no * ni), -1);
-  for (std::size_t k = 0; k < tables.size(); ++k) {
-    const int col = pair_of[k].first + pair_of[k].second * no;
-    if (from[static_cast<std::size_t>(col)] >= 0)
-      throw InputError(paths[k] + ": FRF " + to_string(outputs[k]) + "/" + to_string(inputs[k]) + " already read from " +
-                       paths[static_cast<std::size_t>(from[static_cast<std::size_t>(col)])]);
-    from[static_cast<std::size_t>(col)] = static_cast<int>(k);
-    h.H.col(col).real() = tables[k].columns.col(0);
-    h.H.col(col).imag() = tables[k].columns.col(1);
-  }
-  std::string missing;
-  for (int i = 0; i < ni; ++i)
-    for (int o = 0; o < no; ++o)
-      if (from[static_cast<std::size_t>(o + i * no)] < 0)
-        missing += (missing.empty() ? "" : ", ") + to_string(h.outputs[o].dof) + "/" + to_string(h.inputs[i].dof);
-  if (!missing.empty()) throw InputError(h.source + ": missing FRFs for output/input pairs " + missing);
-  h.validate(h.source);
-  return h;
+  return frf_of_tables(tables, outputs, inputs);
 }
 
 LvmFile read_lvm(const std::string& path) { return parse_lvm(internal::read_file_bytes(path), path); }
@@ -334,7 +475,7 @@ LvmFile parse_lvm(const std::string& bytes, const std::string& path) {
   return out;
 }
 
-TestData read_test_data(const std::string& path, double sample_rate_hz) {
+TestData read_test_data(const std::string& path, double sample_rate_hz, TableKind kind) {
   std::string ext = lower(std::filesystem::path(path).extension().string());
   if (ext != ".uff" && ext != ".unv" && ext != ".lvm" && ext != ".txt" && ext != ".csv" && ext != ".dat" && ext != ".tsv") {
     // By content: the first non-blank line.
@@ -352,11 +493,30 @@ TestData read_test_data(const std::string& path, double sample_rate_hz) {
   } else if (ext == ".lvm") {
     LvmFile f = read_lvm(path);
     d.kind = f.spectrum ? TestData::Kind::kSpectrum : TestData::Kind::kTimeHistory;
+    if (kind == TableKind::kSpectrum && !f.spectrum) d.kind = TestData::Kind::kSpectrum;
+    d.how = f.spectrum ? "LabVIEW spectrum (channel name or X_Dimension)" : "LabVIEW time data";
     d.table = std::move(f.table);
     d.recording = std::move(f.recording);
-  } else {
+  } else if (sample_rate_hz > 0 || kind == TableKind::kTimeHistory) {
     d.kind = TestData::Kind::kTimeHistory;
     d.recording = read_time_text(path, sample_rate_hz);
+    d.how = sample_rate_hz > 0 ? "time history (a sampling rate was given: every column a channel)" : "time history (as told)";
+  } else {
+    const Rows rows = parse_rows(internal::read_file_bytes(path), path);
+    TextTable t = to_table(rows, path, true);
+    const TableKind k = kind != TableKind::kAuto ? kind : classify_text_table(t, &d.how);
+    if (kind != TableKind::kAuto) d.how = std::string(to_string(kind)) + " (as told)";
+    if (k == TableKind::kTimeHistory) {
+      d.kind = TestData::Kind::kTimeHistory;
+      d.recording = recording_of(t, 1.0 / check_even_steps(t.x, rows.line_of, path));
+    } else {
+      d.kind = k == TableKind::kFrf ? TestData::Kind::kFrf : TestData::Kind::kSpectrum;
+      if (k == TableKind::kFrf && (t.columns.cols() % 2 != 0))
+        throw InputError(path + ": an FRF table needs frequency, then real and imaginary columns (an odd number of columns); it has " +
+                         std::to_string(t.columns.cols() + 1));
+      t.dx = t.x.size() > 1 ? (t.x[t.x.size() - 1] - t.x[0]) / static_cast<double>(t.x.size() - 1) : 0.0;
+    }
+    d.table = std::move(t);
   }
   return d;
 }

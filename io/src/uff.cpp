@@ -892,6 +892,15 @@ UffDataset dataset58(Uff58 d) {
 
 }  // namespace
 
+Channel uff_channel(const Uff58& d, double* sign) { return response_channel(d, sign); }
+
+bool uff_reference(const Uff58& d, MeasuredDof* dof) {
+  if (d.reference_node == 0 || d.reference_direction == 0 || std::abs(d.reference_direction) > 6) return false;
+  double s = 1;
+  *dof = uff_dof(d.reference_node, d.reference_direction, &s);
+  return true;
+}
+
 Recording uff_recording(const UffFile& f) {
   const std::vector<Located> t = functions_of_type(f, 1);
   if (t.empty()) throw InputError(f.source + ": no time responses (dataset 58 with function type 1)");
@@ -933,11 +942,20 @@ Recording uff_recording(const UffFile& f) {
   return r;
 }
 
-FrfData uff_frf(const UffFile& f) {
-  const std::vector<Located> t = functions_of_type(f, 4);
-  if (t.empty()) throw InputError(f.source + ": no FRFs (dataset 58 with function type 4)");
+FrfData uff_frf(const UffFile& f) { return uff_frf(std::vector<const UffFile*>{&f}); }
+
+FrfData uff_frf(const std::vector<const UffFile*>& files) {
+  struct At {
+    const UffFile* f;
+    Located l;
+  };
+  std::vector<At> t;
+  for (const UffFile* f : files)
+    for (const Located& l : functions_of_type(*f, 4)) t.push_back({f, l});
+  if (t.empty()) throw InputError((files.empty() ? std::string("UFF") : files[0]->source) + (files.size() > 1 ? " and the other files" : "") +
+                                  ": no FRFs (dataset 58 with function type 4)");
   FrfData h;
-  h.source = f.source;
+  h.source = files[0]->source + (files.size() > 1 ? " and " + std::to_string(files.size() - 1) + " more" : "");
   auto index_of = [](std::vector<Channel>& list, const Channel& c) {
     for (std::size_t k = 0; k < list.size(); ++k)
       if (list[k].dof == c.dof) return static_cast<int>(k);
@@ -947,61 +965,70 @@ FrfData uff_frf(const UffFile& f) {
   struct Entry {
     int o, i;
     std::complex<double> sign;
-    const Located* l;
+    const At* a;
   };
   std::vector<Entry> entries;
-  for (const Located& l : t) {
-    require_same_grid(f, t[0], l, "frequency grid");
+  for (const At& a : t) {
+    if (a.f == t[0].f) require_same_grid(*a.f, t[0].l, a.l, "frequency grid");
+    else {
+      bool same = a.l.d->x.size() == t[0].l.d->x.size();
+      for (Eigen::Index k = 0; same && k < a.l.d->x.size(); ++k)
+        same = std::abs(a.l.d->x[k] - t[0].l.d->x[k]) <= 1e-9 * std::max(std::abs(a.l.d->x[k]), std::abs(t[0].l.d->x[k]));
+      if (!same)
+        throw InputError(at(*a.f, a.l.line) + ": its frequency grid (" + std::to_string(a.l.d->x.size()) + " points) differs from that of " +
+                         at(*t[0].f, t[0].l.line) + " (" + std::to_string(t[0].l.d->x.size()) + " points); FRFs identified together need one grid");
+    }
     double so = 1, si = 1;
-    Channel out = response_channel(*l.d, &so);
+    Channel out = response_channel(*a.l.d, &so);
     out.input = false;
     Channel in;
-    in.dof = uff_dof(l.d->reference_node, l.d->reference_direction, &si);
+    in.dof = uff_dof(a.l.d->reference_node, a.l.d->reference_direction, &si);
     in.quantity = Quantity::kForce;
     in.input = true;
-    in.unit = unit_of(l.d->denominator.unit);
-    in.name = l.d->reference_name != "NONE" ? l.d->reference_name : "";
-    entries.push_back({index_of(h.outputs, out), index_of(h.inputs, in), so * si, &l});
+    in.unit = unit_of(a.l.d->denominator.unit);
+    in.name = a.l.d->reference_name != "NONE" ? a.l.d->reference_name : "";
+    entries.push_back({index_of(h.outputs, out), index_of(h.inputs, in), so * si, &a});
   }
   const int no = h.num_outputs(), ni = h.num_inputs();
-  const Eigen::Index nf = t[0].d->x.size();
-  h.frequency_hz = t[0].d->x;
+  const Eigen::Index nf = t[0].l.d->x.size();
+  h.frequency_hz = t[0].l.d->x;
   h.H.setZero(nf, no * ni);
-  std::vector<int> from(static_cast<std::size_t>(no * ni), 0);
+  std::vector<const At*> from(static_cast<std::size_t>(no * ni), nullptr);
   for (const Entry& e : entries) {
-    int& line = from[static_cast<std::size_t>(e.o + e.i * no)];
-    if (line != 0)
-      throw InputError(at(f, e.l->line) + ": FRF " + to_string(h.outputs[e.o].dof) + "/" + to_string(h.inputs[e.i].dof) +
-                       " already given by the dataset at line " + std::to_string(line));
-    line = e.l->line;
-    h.H.col(e.o + e.i * no) = e.sign * e.l->d->y;
+    const At*& first = from[static_cast<std::size_t>(e.o + e.i * no)];
+    if (first)
+      throw InputError(at(*e.a->f, e.a->l.line) + ": FRF " + to_string(h.outputs[e.o].dof) + "/" + to_string(h.inputs[e.i].dof) +
+                       " already given by " + at(*first->f, first->l.line));
+    first = e.a;
+    h.H.col(e.o + e.i * no) = e.sign * e.a->l.d->y;
   }
   std::string missing;
   for (int i = 0; i < ni; ++i)
     for (int o = 0; o < no; ++o)
-      if (from[static_cast<std::size_t>(o + i * no)] == 0)
+      if (!from[static_cast<std::size_t>(o + i * no)])
         missing += (missing.empty() ? "" : ", ") + to_string(h.outputs[o].dof) + "/" + to_string(h.inputs[i].dof);
   if (!missing.empty())
-    throw InputError(f.source + ": missing FRFs for output/input pairs " + missing +
+    throw InputError(h.source + ": missing FRFs for output/input pairs " + missing +
                      " (every response DOF needs an FRF for every reference DOF)");
   // Coherence in the FRF layout: ordinary coherence (type 6) per output/input pair, or multiple coherence (26)
   // per output repeated over the inputs; kept only if every FRF has one on the same grid.
   Eigen::MatrixXd c = Eigen::MatrixXd::Constant(nf, static_cast<Eigen::Index>(no) * ni, std::numeric_limits<double>::quiet_NaN());
   for (int type : {26, 6})
-    for (const Located& l : functions_of_type(f, type)) {
-      double s = 1;
-      const MeasuredDof d = uff_dof(l.d->response_node, l.d->response_direction, &s);
-      if (l.d->x.size() != nf) continue;
-      for (int o = 0; o < no; ++o) {
-        if (!(h.outputs[o].dof == d)) continue;
-        for (int i = 0; i < ni; ++i) {
-          if (type == 6 && !(h.inputs[i].dof == uff_dof(l.d->reference_node, l.d->reference_direction, &s))) continue;
-          c.col(o + i * no) = l.d->y.real();
+    for (const UffFile* f : files)
+      for (const Located& l : functions_of_type(*f, type)) {
+        double s = 1;
+        const MeasuredDof d = uff_dof(l.d->response_node, l.d->response_direction, &s);
+        if (l.d->x.size() != nf) continue;
+        for (int o = 0; o < no; ++o) {
+          if (!(h.outputs[o].dof == d)) continue;
+          for (int i = 0; i < ni; ++i) {
+            if (type == 6 && !(h.inputs[i].dof == uff_dof(l.d->reference_node, l.d->reference_direction, &s))) continue;
+            c.col(o + i * no) = l.d->y.real();
+          }
         }
       }
-    }
   if (c.allFinite()) h.coherence = c;
-  h.validate(f.source);
+  h.validate(h.source);
   return h;
 }
 
@@ -1052,10 +1079,14 @@ ModalData uff_modal_data(const UffFile& f) {
 std::vector<UffDataset> uff_datasets(const Recording& r, bool binary) {
   r.validate("recording " + r.source);
   std::vector<UffDataset> out;
+  // The reference DOF (record 6): the excitation DOF when the recording has one force channel (a hammer location
+  // or one shaker), so files of one test can be told apart from those of another.
+  const std::vector<int> ins = r.input_channels();
+  const MeasuredDof* ref = ins.size() == 1 && r.channels[static_cast<std::size_t>(ins[0])].dof.node != 0 ? &r.channels[static_cast<std::size_t>(ins[0])].dof : nullptr;
   for (std::size_t k = 0; k < r.records.size(); ++k)
     for (int c = 0; c < r.num_channels(); ++c) {
       const Channel& ch = r.channels[static_cast<std::size_t>(c)];
-      Uff58 d = function_base(1, ch.name, ch.dof, 0, 0);
+      Uff58 d = function_base(1, ch.name, ch.dof, ref ? ref->node : 0, ref ? uff_direction(*ref) : 0);
       d.load_case = static_cast<int>(k) + 1;
       d.binary = binary;
       d.ordinate_type = 4;

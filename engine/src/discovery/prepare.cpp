@@ -53,7 +53,7 @@ NoiseModel noise_model(const ModalData& data, const DiscoveryOptions& o, std::ve
   } else if (data.frequency_std_hz.size() == p && p > 0) {
     std::vector<double> rel;
     for (int k = 0; k < p; ++k) rel.push_back(data.frequency_std_hz[k] / data.frequencies_hz[k]);
-    nm.frequency = median(rel);
+    nm.frequency = std::max(median(rel), o.min_data_frequency_noise);
     nm.frequency_source = NoiseModel::Source::kData;
     nm.frequency_modes = Eigen::Map<const Eigen::VectorXd>(rel.data(), p).cwiseMax(nm.frequency);
   }
@@ -68,7 +68,7 @@ NoiseModel noise_model(const ModalData& data, const DiscoveryOptions& o, std::ve
     nm.shape = o.shape_noise;
     nm.shape_source = NoiseModel::Source::kStated;
   } else if (data.shape_std.size() == p && p > 0) {
-    nm.shape = median(std::vector<double>(data.shape_std.data(), data.shape_std.data() + p));
+    nm.shape = std::max(median(std::vector<double>(data.shape_std.data(), data.shape_std.data() + p)), o.min_data_shape_noise);
     nm.shape_source = NoiseModel::Source::kData;
     nm.shape_modes = data.shape_std.cwiseMax(nm.shape);
   }

@@ -73,11 +73,12 @@ struct Search {
       if (significance(f, k, scale) < p.options.min_significance) return false;
     return true;
   }
-  // Whether adding one effect to `from` (giving `to`) is worth it: decisive, and removing `further` of the misfit
-  // `from` leaves (beyond what the best explored set leaves).
+  // Whether adding one effect to `from` (giving `to`) is worth it: decisive, removing `further` of the misfit
+  // `from` leaves (beyond what the best explored set leaves) and `min_share` of the model's as given.
   bool worth(const SetFit& from, const SetFit& to) const {
     if (!admissible(to)) return false;
     if (evidence(to) - evidence(from) < p.options.decisive) return false;
+    if (from.chi2 - to.chi2 < p.options.min_share * std::max(0.0, chi2_0 - chi2_best)) return false;
     return from.chi2 - to.chi2 >= p.options.further * std::max(0.0, from.chi2 - chi2_best);
   }
 };

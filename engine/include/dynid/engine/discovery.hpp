@@ -36,6 +36,10 @@ struct DiscoveryOptions {
   double frequency_noise = std::numeric_limits<double>::quiet_NaN();
   double shape_noise = std::numeric_limits<double>::quiet_NaN();
   double default_frequency_noise = 0.01, default_shape_noise = 0.05;
+  /// Floors of noise levels taken from the data (an identification's split-data or pole-scatter estimates): those
+  /// see the random error only, not the bias every identification carries (leakage, out-of-band modes, a fitted
+  /// pole model), and on a null case an estimate of 0.15 % made the model's own shapes look decisively wrong.
+  double min_data_frequency_noise = 1e-4, min_data_shape_noise = 0.03;
   /// The model is consistent with the data when the chi-square of its whitened residuals stays below the quantile
   /// 1 - consistency_level of the chi-square distribution (frequencies and shapes tested separately, each at
   /// half this level).
@@ -51,6 +55,11 @@ struct DiscoveryOptions {
   /// approximation of the real physics only part. An explanation that removes less than `partial` of the misfit
   /// beyond the noise leaves the verdict inconclusive (an effect outside the library, or several at once).
   double further = 0.8, partial = 0.5;
+  /// ... and at least `min_share` of the misfit the model as given has beyond the best set's: a candidate that
+  /// approximates the real physics (equal masses for unequal ones, a spring for a soft stub) leaves a misfit in
+  /// proportion to the effect it models, which a second candidate will always reduce; a real second effect
+  /// carries a share of its own.
+  double min_share = 0.01;
   /// A further effect's parameters must differ from nominal by this many standard deviations.
   double min_significance = 3.0;
   int max_iterations = 100;        ///< Ceres iterations per fit

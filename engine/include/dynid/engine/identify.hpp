@@ -2,37 +2,77 @@
 // covariance-driven stochastic subspace identification (output-only, from time data).
 //
 // Both run over a range of model orders, build a stabilization diagram (each pole marked stable in frequency,
-// damping and vector against the previous order), and select modes automatically: physical poles stable in
-// frequency and vector (and within cluster_damping in damping) are clustered across orders (a window of +-cluster_tolerance around the densest pole, one
-// pole per order), and a cluster becomes a mode when it holds a pole in at least `min_cluster_fraction` of the
-// orders. The mode's frequency and damping are the cluster medians; their standard deviations across the cluster
-// are reported as the uncertainty (the spread over model orders).
+// damping and vector against the nearest pole of the previous order), and select modes automatically:
+//   1. Each physical pole gets a stability weight in [0, 1]: 1 while its frequency, damping and vector changes
+//      against the previous order are within the tolerances below, falling linearly to 0 at twice them. The
+//      weight is continuous in the poles, so rounding (another thread count, another BLAS) moves it by rounding,
+//      never from 0 to 1: no selection decision below hinges on one pole crossing a threshold.
+//   2. Clusters: the pole frequencies are grouped around the maxima of their weighted density (mean shift with
+//      a window of +-cluster_tolerance, relative); a cluster's support is the sum over the orders of the weight
+//      of the order's best pole in the window (the window's edge weighs 0), divided by the number of orders.
+//      Its frequency and damping are the support-weighted means of those poles; their weighted standard
+//      deviations are the spread over orders.
+//   3. Evidence, each a reason to reject a cluster (listed in IdentificationSummary::rejected):
+//        support below min_cluster_fraction (not stable over enough orders);
+//        shape: MPC below min_mpc (not a normal mode: noise or a mathematical pole);
+//        mode indicator (CMIF for FRFs, the first singular value of the output spectral matrix for output-only
+//          data) more than trough_db below the straight line (in dB) between its values a few half-power
+//          bandwidths either side: the pole sits in a trough (an anti-resonance), not on a peak or a shoulder;
+//        a split: within max(merge_tolerance, zeta) in frequency of a stronger cluster (one half-power
+//          half-bandwidth) with a shape MAC >= merge_mac: one physical mode whose poles drifted over orders. Splits
+//          are merged before the other checks: the group's support counts, per order, its best pole; its
+//          frequency, damping and shape are the strongest cluster's.
+// Uncertainty: the spread over orders understates the scatter of a mode from one data set to the next. With
+// recordings (identify_recordings), the two halves of the data (records, or the two halves in time of one
+// record) are identified again with the same settings; halves' modes are paired with the full data's by MAC;
+// per mode, sigma_f = |f_A - f_B| / 2 and sigma_shape = rms(u_A - u_B) / 2 (shapes scaled to a largest entry
+// of 1, signs aligned) estimate the standard deviation of the full data's estimates (each half has twice the
+// variance of the whole, their difference four times). One pair is a one-degree-of-freedom estimate, so the
+// relative values |f_A - f_B| / (2 f zeta) (frequency scatter scales with the half-power bandwidth) and the
+// shape values are pooled over the modes by their median (scaled by 1 / 0.6745, the median of |N(0, 1)|), and
+// each mode reports the larger of its own and the pooled value (a mode with no partner in a half gets the
+// pooled value). frequency_std_hz is that estimate (or the spread over orders when there is none).
 #pragma once
 
 #include <complex>
 #include <string>
 #include <vector>
 
+#include "dynid/engine/frf.hpp"
 #include "dynid/engine/recording.hpp"
 #include "dynid/mesh/model.hpp"
 
 namespace dynid {
 
 struct IdentificationOptions {
-  double band_lo_hz = 0, band_hi_hz = 0;  ///< analysis band (0, 0 = everything above 0 Hz the data holds)
-  int min_order = 0, max_order = 0;       ///< model orders (0 = automatic: LSCF 2..40 per input; SSI 2..80)
+  /// Analysis band. 0, 0 = identify_lscf / identify_ssi: everything the data holds above 0 Hz;
+  /// identify_recordings: from the data's spectral peaks (plan_identification).
+  double band_lo_hz = 0, band_hi_hz = 0;
+  int min_order = 0, max_order = 0;       ///< model orders (0 = automatic: LSCF 2..max(10, 60 / inputs); SSI 2..80)
   int order_step = 0;                     ///< 0 = 1 (LSCF), 2 (SSI)
-  // Stabilization criteria against the previous order.
+  // Stability against the previous order (full weight within these, none beyond twice them).
   double stable_frequency = 0.01;   ///< relative frequency change
-  double stable_damping = 0.05;     ///< relative damping change
-  double cluster_damping = 0.25;    ///< relative damping change allowed for poles that join clusters
+  double stable_damping = 0.05;     ///< relative damping change (the diagram's "stable in damping" mark)
+  double cluster_damping = 0.25;    ///< relative damping change of the poles that support clusters
   double stable_mac = 0.98;         ///< MAC of the pole's vector (participation for LSCF, shape for SSI)
   double max_damping = 0.2;         ///< poles with zeta outside (0, max_damping) are not physical
-  double min_cluster_fraction = 0.45; ///< of the orders, for a cluster to count as a mode
+  double min_cluster_fraction = 0.45; ///< support a cluster needs (weighted share of the orders)
   double cluster_tolerance = 0.01;    ///< half-width of a cluster's window (relative frequency)
+  // Evidence a cluster needs to be reported as a mode (see the header comment).
+  double min_mpc = 0.5;             ///< modal phase collinearity of its shape
+  double trough_db = 3;             ///< how far below its surroundings the mode indicator may sit
+  double merge_tolerance = 0.03;    ///< clusters this close (relative, or zeta if wider) ...
+  double merge_mac = 0.9;           ///< ... with shapes this alike are one mode
   // SSI-cov.
   int block_rows = 0;  ///< i (0 = automatic from the band's lowest frequency and the maximum order)
   int decimate = 0;    ///< 0 = automatic (to about 2.5x the band's top), 1 = none
+  // From recordings (identify_recordings).
+  /// Samples per FRF segment for continuous records (random excitation): -1 = from the plan (the lowest peak's
+  /// half-power bandwidth spans 4 lines, within the record), 0 = whole records (impacts: always whole records).
+  int segment = -1;
+  FrfOptions::Estimator estimator = FrfOptions::Estimator::kH1;
+  double exponential_end = 0;       ///< exponential window on impact records (FrfOptions::exponential_end)
+  bool split_uncertainty = true;    ///< the split-data estimate of the frequency and shape uncertainty
   bool IsValid(std::string* why) const;
 };
 
@@ -44,13 +84,20 @@ struct StabilizationPole {
   bool stable_frequency = false, stable_damping = false, stable_vector = false;
   int cluster = -1;       ///< index of the selected mode it supports, or -1
   double damping_change = 1;  ///< |zeta - zeta_previous| / zeta against the nearest pole of the previous order
+  double weight = 0;      ///< stability weight in [0, 1] (header comment, step 1)
   bool stable() const { return stable_frequency && stable_damping && stable_vector; }
 };
 
 struct IdentifiedMode {
   double frequency_hz = 0, damping_ratio = 0;
-  double frequency_std_hz = 0, damping_std = 0;  ///< spread over the model orders of its cluster
+  /// Standard deviations: the split-data estimate when there is one (header comment), else the spread over
+  /// the model orders of its cluster.
+  double frequency_std_hz = 0, damping_std = 0;
+  double order_frequency_std_hz = 0;             ///< spread of the frequency over the model orders
+  double shape_std = 0;  ///< std of the shape entries relative to the largest (split data; 0 = not estimated)
   int poles = 0;                                 ///< poles in its cluster (orders that found it)
+  double support = 0;                            ///< weighted share of the orders (header comment, step 2)
+  double indicator_db = 0;  ///< mode indicator above (+) or below (-) the line between its surroundings, dB
   Eigen::VectorXcd shape;                        ///< complex shape at the outputs (LSFD residues / SSI C psi)
   Eigen::VectorXd real_shape;                    ///< real-normalized (best real rotation), max |.| = 1
   double mpc = 0;                                ///< modal phase collinearity (1 = a real, normal mode)
@@ -61,21 +108,73 @@ struct IdentifiedMode {
   double twin_mac = 0;
 };
 
+/// Why a cluster of poles was not reported as a mode.
+enum class Rejection {
+  kFewOrders,        ///< support below min_cluster_fraction
+  kComplexShape,     ///< MPC below min_mpc
+  kIndicatorTrough,  ///< the mode indicator sits in a trough there
+  kSplit             ///< a split of a stronger cluster with the same shape (merged into it)
+};
+const char* to_string(Rejection r);  // "few orders", "complex shape", "indicator trough", "split"
+
+struct RejectedCluster {
+  double frequency_hz = 0, damping_ratio = 0;
+  int poles = 0;
+  double support = 0;
+  Rejection reason = Rejection::kFewOrders;
+  double value = 0, limit = 0;  ///< the measured quantity and its limit (support, MPC, dB, or MAC for a split)
+  int merged_into = -1;         ///< kSplit: index of the mode it was merged into
+};
+
 struct IdentificationSummary {
   std::string method;                   ///< "lscf" or "ssi"
   std::vector<MeasuredDof> dofs;        ///< outputs (rows of the shapes)
   std::vector<IdentifiedMode> modes;    ///< ascending frequency
+  std::vector<RejectedCluster> rejected;  ///< every cluster of >= 2 poles not reported, ascending frequency
   std::vector<StabilizationPole> poles; ///< every pole of every order (the diagram)
   int min_order = 0, max_order = 0;
-  // Background of the diagram: sum over the FRFs of |H| (LSCF) or the first singular value of the output
-  // cross-spectral matrix (SSI), on `frequency_hz`.
+  double band_lo_hz = 0, band_hi_hz = 0;  ///< the band analysed
+  bool band_from_data = false;            ///< the band came from the spectral peaks (plan_identification)
+  double resolution_hz = 0;               ///< frequency line spacing of the FRFs / spectra (0 = not from a transform)
+  // Background of the diagram and the mode indicator: CMIF, the first singular value of the FRF matrix (LSCF),
+  // or the first singular value of the output cross-spectral matrix (SSI), on `frequency_hz`.
   Eigen::VectorXd frequency_hz, background;
   std::string background_label;
   double window_decay_removed = 0;  ///< exponential-window decay taken off the poles (1/s)
+  // Split-data uncertainty (identify_recordings): 0 = not estimated.
+  int uncertainty_halves = 0;          ///< 2 when estimated
+  double pooled_frequency_std = 0;     ///< pooled sigma_f / (f zeta) (header comment)
+  double pooled_shape_std = 0;         ///< pooled shape std relative to the largest entry
+  std::vector<std::string> notes;      ///< what the plan and the uncertainty estimate did, in words
   double seconds = 0;
-  /// The modes as ModalData (real-normalized shapes, damping, MPC, standard deviations).
+  /// The modes as ModalData (real-normalized shapes, damping, MPC, standard deviations, shape_std).
   ModalData modal_data(const std::string& source) const;
 };
+
+/// The band and frequency resolution for recordings when the options leave them open: from the peaks of the
+/// mode indicator (first singular value of the output cross-spectral matrix; whole records for impacts,
+/// Welch segments of an eighth of the record otherwise).
+///   band: [0.5 x lowest peak, min(1.25 x highest peak, 0.45 x sampling rate)], over the peaks that stand
+///         >= 10 dB above their surroundings (prominence) and >= 10 dB above the spectrum's 10th-percentile
+///         level (the noise floor); the whole range below 0.45 fs when there is none.
+///   resolution (continuous records): the lowest peak's half-power bandwidth 2 zeta f (zeta from the -3 dB
+///         width, refined with longer segments while the width spans fewer than 4 lines) spans 4 lines:
+///         segment = fs / (zeta f / 2), a power of two, at most a quarter of the shortest record (>= 7
+///         averages with half overlap).
+struct IdentificationPlan {
+  double band_lo_hz = 0, band_hi_hz = 0;
+  bool band_from_data = false;
+  bool impulsive = false;      ///< records are impacts (one per hit): transforms over whole records
+  int segment = 0;             ///< samples per FRF / Welch segment (0 = whole records)
+  double resolution_hz = 0;
+  double lowest_peak_hz = 0, lowest_peak_damping = 0;  ///< 0 = no peak found
+  std::vector<double> peaks_hz;  ///< the peaks the band rule used, ascending
+  std::vector<std::string> notes;
+};
+IdentificationPlan plan_identification(const std::vector<Recording>& recordings, const IdentificationOptions& options);
+/// The band of FRFs by the same rule, from the peaks of their CMIF (first singular value at every line); the
+/// resolution is the FRFs' own.
+IdentificationPlan plan_identification(const FrfData& frf, const IdentificationOptions& options);
 
 /// LSCF (poly-reference when the FRFs have several inputs) on FRFs; shapes by LSFD with lower and upper
 /// residuals at the selected poles. Any response quantity works (poles do not depend on it); shapes are
@@ -103,11 +202,15 @@ struct ModelBand {
 };
 ModelBand band_from_model(const Model& model, const std::vector<MeasuredDof>& sensors, double nyquist_hz, int modes = 8);
 
-/// Recordings identified as a whole: "lscf" on H1 FRFs (recordings with force channels; a roving hammer gives one
+/// Recordings identified as a whole: "lscf" on FRFs (recordings with force channels; a roving hammer gives one
 /// recording per hit location) or "ssi" (output-only; records of all recordings concatenated); "" picks by the
-/// data.
+/// data. The band and resolution come from plan_identification where the options leave them open; then the
+/// split-data uncertainty (header comment) when options.split_uncertainty.
 IdentificationSummary identify_recordings(std::vector<Recording> recordings, const std::string& method,
                                           const IdentificationOptions& options);
+/// FRFs identified with LSCF (the band from plan_identification where the options leave it open), with the
+/// split-data uncertainty when `halves` holds the FRFs of the two halves of the data (e.g. of alternate hits).
+IdentificationSummary identify_frfs(const FrfData& frf, const IdentificationOptions& options, const std::vector<FrfData>& halves = {});
 
 /// Peaks of a magnitude spectrum (e.g. a dB spectrum without phase): local maxima in [lo, hi] standing at
 /// least `min_prominence_db` above the higher of the two minima that separate them from higher peaks (or the

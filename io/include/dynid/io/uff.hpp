@@ -179,6 +179,13 @@ std::string uff_data_type_name(int type);
 
 // ---- Conversions to and from dynid's test data -----------------------------------------------------------------
 
+/// The channel a 58 dataset measures: its response DOF (node, direction; `sign` gets -1 for a negative direction,
+/// by which the data must be multiplied so the channel's DOF is positive), quantity from the ordinate's specific
+/// data type (8 displacement, 11 velocity, 12 acceleration, 9 and 13 force; 13 marks an input), unit and name.
+Channel uff_channel(const Uff58& d, double* sign);
+/// The reference DOF of a 58 dataset (record 6 fields 9-10; node 0 or direction 0 = none given).
+bool uff_reference(const Uff58& d, MeasuredDof* dof);
+
 /// The time responses (function type 1) of a file as a Recording: one channel per response DOF (node,
 /// direction; negative directions flip the data so the channel's DOF is positive), quantity from the ordinate's
 /// specific data type (8 displacement, 11 velocity, 12 acceleration, 9 and 13 force; 13 marks an input). A DOF
@@ -188,6 +195,8 @@ Recording uff_recording(const UffFile& f);
 /// all on the same frequency grid; every output/input pair must be present. Multiple coherence (type 26) per
 /// output is taken when present for every output.
 FrfData uff_frf(const UffFile& f);
+/// The same over several files (one FRF per file, one file per reference, ...): their FRFs together.
+FrfData uff_frf(const std::vector<const UffFile*>& files);
 /// The modes (55, analysis type 2, 3 or 7) of a file. Complex shapes are rotated to their largest component and
 /// the real part is kept. DOFs that are exactly zero in every mode are left out (UFF 55 has no "not measured").
 ModalData uff_modal_data(const UffFile& f);

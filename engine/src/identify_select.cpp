@@ -1,0 +1,296 @@
+// Automatic mode selection: stability weights, mean-shift clusters over orders, evidence checks (see
+// dynid/engine/identify.hpp, header comment, steps 1-3).
+#include "internal/identify_select.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace dynid::internal {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+
+// Full weight up to the tolerance, falling linearly to 0 at twice it: continuous, so rounding cannot flip it.
+double ramp(double x) { return std::clamp(2.0 - x, 0.0, 1.0); }
+// The window of a cluster: flat over its inner half, to 0 at its edge (u = |f - fc| / (tol fc)).
+double window(double u) { return std::clamp(2.0 * (1.0 - u), 0.0, 1.0); }
+
+struct Cand {
+  int pole;  // index in s.poles
+  int j, p;  // order index, pole index
+  double f, w;
+};
+}  // namespace
+
+double pole_hz(std::complex<double> l) { return std::abs(l) / (2 * kPi); }
+double pole_zeta(std::complex<double> l) { return -l.real() / std::abs(l); }
+double complex_mac(const Eigen::VectorXcd& a, const Eigen::VectorXcd& b) {
+  const double d = a.squaredNorm() * b.squaredNorm();
+  return d > 0 ? std::norm(a.dot(b)) / d : 0.0;
+}
+std::complex<double> pole_of(double f, double zeta) {
+  const double w = 2 * kPi * f;
+  return {-zeta * w, w * std::sqrt(std::max(0.0, 1 - zeta * zeta))};
+}
+
+std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<RawPole>>& orders, const std::vector<int>& order_of, double lo,
+                                               double hi, const IdentificationOptions& o, IdentificationSummary& s) {
+  // Step 1: the diagram, with hard flags (drawn) and continuous weights (used).
+  std::vector<Cand> cand;
+  for (std::size_t j = 0; j < orders.size(); ++j)
+    for (std::size_t p = 0; p < orders[j].size(); ++p) {
+      const RawPole& rp = orders[j][p];
+      StabilizationPole sp;
+      sp.order = order_of[j];
+      sp.frequency_hz = pole_hz(rp.lambda);
+      sp.damping_ratio = pole_zeta(rp.lambda);
+      sp.physical = sp.frequency_hz >= lo && sp.frequency_hz <= hi && sp.damping_ratio > 0 && sp.damping_ratio < o.max_damping;
+      if (j > 0 && !orders[j - 1].empty()) {
+        const RawPole* best = nullptr;
+        double bd = 1e300;
+        for (const RawPole& q : orders[j - 1]) {
+          const double d = std::abs(pole_hz(q.lambda) - sp.frequency_hz);
+          if (d < bd) bd = d, best = &q;
+        }
+        const double zq = pole_zeta(best->lambda);
+        const double df = bd / sp.frequency_hz;
+        sp.damping_change = std::abs(zq - sp.damping_ratio) / std::max(std::abs(sp.damping_ratio), 1e-12);
+        const double mac = rp.vec.size() <= 1 ? 1.0 : complex_mac(rp.vec, best->vec);
+        sp.stable_frequency = df <= o.stable_frequency;
+        sp.stable_damping = sp.damping_change <= o.stable_damping;
+        sp.stable_vector = mac >= o.stable_mac;
+        if (sp.frequency_hz > 0 && sp.damping_ratio > 0) {
+          // Soft physical limits: damping towards max_damping, frequency towards the band edges (1 % of f).
+          const double edge = 0.01 * sp.frequency_hz;
+          const double phys = std::clamp((o.max_damping - sp.damping_ratio) / (0.25 * o.max_damping), 0.0, 1.0) *
+                              std::clamp((sp.frequency_hz - lo) / edge + 0.5, 0.0, 1.0) * std::clamp((hi - sp.frequency_hz) / edge + 0.5, 0.0, 1.0);
+          sp.weight = phys * ramp(df / o.stable_frequency) * ramp(sp.damping_change / o.cluster_damping) *
+                      ramp((1 - mac) / std::max(1 - o.stable_mac, 1e-12));
+        }
+      }
+      if (sp.weight > 0)
+        cand.push_back({static_cast<int>(s.poles.size()), static_cast<int>(j), static_cast<int>(p), sp.frequency_hz, sp.weight});
+      s.poles.push_back(sp);
+    }
+  if (cand.empty()) return {};
+  std::sort(cand.begin(), cand.end(), [](const Cand& a, const Cand& b) { return a.f < b.f || (a.f == b.f && a.pole < b.pole); });
+  const double tol = o.cluster_tolerance;
+  std::vector<double> fs(cand.size());
+  for (std::size_t a = 0; a < cand.size(); ++a) fs[a] = cand[a].f;
+  // Weighted mean of the candidates in the window around f.
+  auto shift = [&](double f, double* mass) {
+    const double h = tol * f;
+    const auto b = std::lower_bound(fs.begin(), fs.end(), f - h) - fs.begin();
+    const auto e = std::upper_bound(fs.begin(), fs.end(), f + h) - fs.begin();
+    double sw = 0, swf = 0;
+    for (auto a = b; a < e; ++a) {
+      const double k = cand[static_cast<std::size_t>(a)].w * window(std::abs(cand[static_cast<std::size_t>(a)].f - f) / h);
+      sw += k, swf += k * cand[static_cast<std::size_t>(a)].f;
+    }
+    *mass = sw;
+    return sw > 0 ? swf / sw : f;
+  };
+  // Step 2: mean shift from every candidate to a maximum of the weighted density.
+  std::vector<std::pair<double, double>> tops;  // (converged frequency, weight of the start)
+  for (const Cand& c : cand) {
+    double f = c.f, mass = 0;
+    for (int it = 0; it < 200; ++it) {
+      const double g = shift(f, &mass);
+      const bool done = std::abs(g - f) <= 1e-10 * f;
+      f = g;
+      if (done) break;
+    }
+    tops.emplace_back(f, c.w);
+  }
+  std::sort(tops.begin(), tops.end());
+  // Converged points within a quarter window of each other are one centre (their weighted mean).
+  std::vector<double> centres;
+  for (std::size_t a = 0; a < tops.size();) {
+    std::size_t b = a + 1;
+    double sw = tops[a].second, swf = tops[a].second * tops[a].first;
+    while (b < tops.size() && tops[b].first - tops[b - 1].first <= 0.25 * tol * tops[b - 1].first) sw += tops[b].second, swf += tops[b].second * tops[b].first, ++b;
+    centres.push_back(sw > 0 ? swf / sw : tops[a].first);
+    a = b;
+  }
+  // Each candidate supports the centre it is nearest to (relative distance); per order the best one counts.
+  const std::size_t nc = centres.size();
+  std::vector<std::map<int, std::pair<double, std::size_t>>> best(nc);  // centre -> order -> (weight, cand)
+  for (std::size_t a = 0; a < cand.size(); ++a) {
+    const auto it = std::lower_bound(centres.begin(), centres.end(), cand[a].f);
+    std::size_t c = static_cast<std::size_t>(it - centres.begin());
+    if (c == nc || (c > 0 && std::abs(cand[a].f - centres[c - 1]) / centres[c - 1] < std::abs(centres[c] - cand[a].f) / centres[c])) --c;
+    const double k = cand[a].w * window(std::abs(cand[a].f - centres[c]) / (tol * centres[c]));
+    if (k <= 0) continue;
+    auto& slot = best[c][cand[a].j];
+    if (k > slot.first) slot = {k, a};
+  }
+  std::vector<PoleCluster> out;
+  const double n_orders = static_cast<double>(orders.size());
+  for (std::size_t c = 0; c < nc; ++c) {
+    if (best[c].size() < 2) continue;
+    PoleCluster pc;
+    double sw = 0, sf = 0, sz = 0;
+    for (const auto& [ord, wk] : best[c]) {
+      const Cand& q = cand[wk.second];
+      pc.members.emplace_back(q.j, q.p);
+      pc.member_weight.push_back(wk.first);
+      pc.diagram_index.push_back(q.pole);
+      sw += wk.first;
+      sf += wk.first * q.f;
+      sz += wk.first * s.poles[static_cast<std::size_t>(q.pole)].damping_ratio;
+    }
+    pc.support = sw / n_orders;
+    pc.poles = static_cast<int>(best[c].size());
+    pc.frequency_hz = sf / sw;
+    pc.damping_ratio = sz / sw;
+    double vf = 0, vz = 0;
+    for (std::size_t m = 0; m < pc.members.size(); ++m) {
+      const StabilizationPole& sp = s.poles[static_cast<std::size_t>(pc.diagram_index[m])];
+      vf += pc.member_weight[m] * std::pow(sp.frequency_hz - pc.frequency_hz, 2);
+      vz += pc.member_weight[m] * std::pow(sp.damping_ratio - pc.damping_ratio, 2);
+    }
+    pc.frequency_std_hz = std::sqrt(vf / sw);
+    pc.damping_std = std::sqrt(vz / sw);
+    out.push_back(std::move(pc));
+  }
+  return out;
+}
+
+double indicator_peakness(const Eigen::VectorXd& f, const Eigen::VectorXd& ind, double fr, double zeta) {
+  const Eigen::Index n = f.size();
+  if (n < 3 || ind.size() != n) return 0;
+  const double df = (f[n - 1] - f[0]) / static_cast<double>(n - 1);
+  const double w = std::max(2 * zeta * fr, 2 * df);
+  // The indicator in dB, linearly interpolated between lines.
+  auto at = [&](double x) {
+    const double pos = std::clamp((x - f[0]) / df, 0.0, static_cast<double>(n - 1));
+    const Eigen::Index k = std::min<Eigen::Index>(static_cast<Eigen::Index>(pos), n - 2);
+    const double t = pos - static_cast<double>(k);
+    auto db = [&](Eigen::Index i) { return 10 * std::log10(std::max(ind[i], 1e-300)); };
+    return (1 - t) * db(k) + t * db(k + 1);
+  };
+  // The mode's level: the highest of its line neighbourhood (+- max(zeta f, df)).
+  const double h = std::max(zeta * fr, df);
+  double top = -1e300;
+  for (int q = -4; q <= 4; ++q) top = std::max(top, at(fr + q * h / 4));
+  const bool has_lo = fr - w >= f[0], has_hi = fr + w <= f[n - 1];
+  if (has_lo && has_hi) return top - 0.5 * (at(fr - w) + at(fr + w));
+  if (has_lo) return top - at(fr - w);
+  if (has_hi) return top - at(fr + w);
+  return 0;
+}
+
+namespace {
+// Support of several clusters together: per order the best weight of any of them.
+double joint_support(const std::vector<Candidate>& cands, const std::vector<std::size_t>& group, std::size_t n_orders) {
+  std::map<int, double> best;
+  for (std::size_t k : group) {
+    const PoleCluster& c = cands[k].cluster;
+    for (std::size_t m = 0; m < c.members.size(); ++m) {
+      double& b = best[c.members[m].first];
+      b = std::max(b, c.member_weight[m]);
+    }
+  }
+  double sum = 0;
+  for (const auto& [j, w] : best) sum += w;
+  return sum / static_cast<double>(n_orders);
+}
+}  // namespace
+
+std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& cands, const std::vector<double>& peakness,
+                                                     const IdentificationOptions& o, std::size_t n_orders, IdentificationSummary& s) {
+  auto reject = [&](const PoleCluster& c, Rejection r, double value, double limit, int into = -1) {
+    RejectedCluster rc;
+    rc.frequency_hz = c.frequency_hz;
+    rc.damping_ratio = c.damping_ratio;
+    rc.poles = c.poles;
+    rc.support = c.support;
+    rc.reason = r;
+    rc.value = value;
+    rc.limit = limit;
+    rc.merged_into = into;
+    s.rejected.push_back(rc);
+  };
+  // 1. Splits: clusters with a shape, strongest first; a weaker one within the merge window with the same shape
+  //    joins the stronger (one physical mode whose poles drifted over the orders).
+  std::vector<std::size_t> order;
+  for (std::size_t k = 0; k < cands.size(); ++k) {
+    if (cands[k].shape.size() > 0) order.push_back(k);
+    else reject(cands[k].cluster, Rejection::kFewOrders, cands[k].cluster.support, o.min_cluster_fraction);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return cands[a].strength > cands[b].strength; });
+  std::vector<std::vector<std::size_t>> groups;
+  std::vector<Eigen::VectorXcd> head_shape;
+  for (std::size_t k : order) {
+    const PoleCluster& c = cands[k].cluster;
+    const Eigen::VectorXcd sk = real_normalize(cands[k].shape).cast<std::complex<double>>();
+    int into = -1;
+    for (std::size_t g = 0; g < groups.size() && into < 0; ++g) {
+      const PoleCluster& h = cands[groups[g][0]].cluster;
+      const double tol = std::max(o.merge_tolerance, std::max(c.damping_ratio, h.damping_ratio));
+      if (std::abs(c.frequency_hz - h.frequency_hz) > tol * h.frequency_hz) continue;
+      if (complex_mac(sk, head_shape[g]) >= o.merge_mac) into = static_cast<int>(g);
+    }
+    if (into < 0) {
+      groups.push_back({k});
+      head_shape.push_back(sk);
+    } else {
+      groups[static_cast<std::size_t>(into)].push_back(k);
+    }
+  }
+  // 2. Support (of the group), MPC and the mode indicator (of its strongest cluster).
+  std::vector<std::vector<std::size_t>> kept;
+  for (const std::vector<std::size_t>& g : groups) {
+    const Candidate& h = cands[g[0]];
+    const double support = joint_support(cands, g, n_orders);
+    const double mpc = modal_phase_collinearity(h.shape);
+    bool ok = false;
+    if (support < o.min_cluster_fraction) {
+      for (std::size_t k : g) reject(cands[k].cluster, Rejection::kFewOrders, support, o.min_cluster_fraction);
+    } else if (mpc < o.min_mpc) {
+      for (std::size_t k : g) reject(cands[k].cluster, Rejection::kComplexShape, mpc, o.min_mpc);
+    } else if (peakness[g[0]] < -o.trough_db) {
+      for (std::size_t k : g) reject(cands[k].cluster, Rejection::kIndicatorTrough, peakness[g[0]], -o.trough_db);
+    } else {
+      ok = true;
+    }
+    if (ok) kept.push_back(g);
+  }
+  // Ascending frequency (of the strongest cluster); the splits are listed against the mode they joined.
+  std::sort(kept.begin(), kept.end(), [&](const auto& a, const auto& b) { return cands[a[0]].cluster.frequency_hz < cands[b[0]].cluster.frequency_hz; });
+  for (std::size_t r = 0; r < kept.size(); ++r)
+    for (std::size_t i = 1; i < kept[r].size(); ++i) {
+      const std::size_t k = kept[r][i];
+      const double mac = complex_mac(real_normalize(cands[k].shape).cast<std::complex<double>>(), real_normalize(cands[kept[r][0]].shape).cast<std::complex<double>>());
+      reject(cands[k].cluster, Rejection::kSplit, mac, o.merge_mac, static_cast<int>(r));
+    }
+  std::sort(s.rejected.begin(), s.rejected.end(), [](const RejectedCluster& a, const RejectedCluster& b) { return a.frequency_hz < b.frequency_hz; });
+  return kept;
+}
+
+void make_modes(const std::vector<Candidate>& cands, const std::vector<double>& peakness, const std::vector<std::vector<std::size_t>>& accepted,
+                std::size_t n_orders, IdentificationSummary& s) {
+  s.modes.clear();
+  for (const std::vector<std::size_t>& g : accepted) {
+    const Candidate& c = cands[g[0]];
+    IdentifiedMode m;
+    // Frequency, damping and their spreads are the strongest cluster's (a split's drifted poles would bias them).
+    m.frequency_hz = c.cluster.frequency_hz;
+    m.damping_ratio = c.cluster.damping_ratio;
+    m.order_frequency_std_hz = m.frequency_std_hz = c.cluster.frequency_std_hz;
+    m.damping_std = c.cluster.damping_std;
+    m.indicator_db = peakness[g[0]];
+    m.shape = c.shape;
+    m.mpc = modal_phase_collinearity(c.shape);
+    m.real_shape = real_normalize(c.shape);
+    m.support = joint_support(cands, g, n_orders);
+    for (std::size_t k : g) {
+      m.poles += cands[k].cluster.poles;
+      for (int d : cands[k].cluster.diagram_index) s.poles[static_cast<std::size_t>(d)].cluster = static_cast<int>(s.modes.size());
+    }
+    s.modes.push_back(std::move(m));
+  }
+}
+
+}  // namespace dynid::internal

@@ -1,0 +1,69 @@
+// Automatic mode selection shared by LSCF and SSI (see dynid/engine/identify.hpp, header comment): stability
+// weights, mean-shift clusters, and the evidence checks. Internal to the engine.
+#pragma once
+
+#include <complex>
+#include <functional>
+#include <vector>
+
+#include "dynid/engine/identify.hpp"
+
+namespace dynid::internal {
+
+/// A pole of one model order with the vector the stability check compares (participation or shape).
+struct RawPole {
+  std::complex<double> lambda;  ///< continuous time, rad/s, Im > 0
+  Eigen::VectorXcd vec;
+};
+
+double pole_hz(std::complex<double> l);
+double pole_zeta(std::complex<double> l);
+double complex_mac(const Eigen::VectorXcd& a, const Eigen::VectorXcd& b);
+/// The continuous-time pole of a frequency and damping ratio.
+std::complex<double> pole_of(double frequency_hz, double zeta);
+
+/// A cluster of poles across orders (step 2).
+struct PoleCluster {
+  double frequency_hz = 0, damping_ratio = 0, frequency_std_hz = 0, damping_std = 0;
+  double support = 0;                    ///< weighted share of the orders
+  int poles = 0;                         ///< orders with a supporting pole
+  std::vector<std::pair<int, int>> members;  ///< (order index, pole index) of each order's best pole
+  std::vector<double> member_weight;     ///< their weights (stability x window)
+  std::vector<int> diagram_index;        ///< their index in IdentificationSummary::poles
+};
+
+/// Steps 1-2: fills s.poles (the diagram with stability flags and weights) and returns every cluster of >= 2
+/// poles, ascending in frequency.
+std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<RawPole>>& orders, const std::vector<int>& order_of, double lo,
+                                               double hi, const IdentificationOptions& o, IdentificationSummary& s);
+
+/// How far (dB) the mode indicator stands above (+) or below (-) the straight line, in dB, between its values at
+/// f -+ w, w = max(2 zeta f, 2 df) (df the line spacing); at a band edge, against the one side it has.
+double indicator_peakness(const Eigen::VectorXd& frequency_hz, const Eigen::VectorXd& indicator, double f, double zeta);
+
+/// A cluster with its shape, for the evidence checks.
+struct Candidate {
+  PoleCluster cluster;
+  Eigen::VectorXcd shape;
+  double strength = 0;  ///< which of two splits is the stronger (support)
+};
+
+/// Step 3: the checks, on candidates with shapes (those without one, below the shaping limit, are rejected for
+/// their support). Splits are merged first (a weaker cluster within the merge window with the same shape joins
+/// the stronger), then each group is checked: joint support, MPC and mode indicator of its strongest cluster.
+/// Returns the accepted modes, ascending in frequency, each as its strongest candidate followed by the splits
+/// merged into it; appends every rejected candidate to s.rejected. `peakness` gives each candidate's
+/// indicator_peakness; `n_orders` the number of model orders.
+std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& candidates, const std::vector<double>& peakness,
+                                                     const IdentificationOptions& o, std::size_t n_orders, IdentificationSummary& s);
+
+/// The accepted modes as IdentifiedModes (frequency, damping, spreads and shape of the strongest cluster, the
+/// joint support of all), and the diagram's poles marked with their mode.
+void make_modes(const std::vector<Candidate>& candidates, const std::vector<double>& peakness, const std::vector<std::vector<std::size_t>>& accepted,
+                std::size_t n_orders, IdentificationSummary& s);
+
+/// Clusters with at least this share of min_cluster_fraction get a shape and the evidence checks (weaker ones
+/// are rejected for their support without one).
+constexpr double kShapedShare = 1.0 / 3.0;
+
+}  // namespace dynid::internal
