@@ -11,7 +11,9 @@ namespace dynid {
 
 /// {"method", "dofs", "orders": [min, max], "seconds", "window_decay_removed",
 ///  "modes": [{"frequency_hz", "damping_ratio", "frequency_std_hz", "damping_std", "mpc", "contribution",
-///             "poles", "shape": {dof: value}}]}; the modes array reads back with read_modal_data.
+///             "poles", "shape": {dof: value}}],
+///  "stabilization": {"poles": [[order, frequency_hz, damping_ratio, class, mode]], "frequency_hz", "background",
+///                    "background_label"}}; the modes array reads back with read_modal_data.
 nlohmann::ordered_json identification_json(const IdentificationSummary& s);
 
 /// The stabilization diagram: model order against frequency, each pole marked by what it is stable in
