@@ -11,6 +11,7 @@
 #include "dynid/io/model_plots.hpp"
 #include "dynid/io/output.hpp"
 #include "dynid/io/plot.hpp"
+#include "dynid/io/results_json.hpp"
 #include "dynid/mesh/error.hpp"
 #include "progress.hpp"
 
@@ -22,48 +23,6 @@ struct DetectArgs {
   std::string case_path, json, plot;
   bool study = false, force = false;
 };
-
-nlohmann::json summary_json(const Case& c, const Model& model, const DetectSummary& S) {
-  nlohmann::json j;
-  j["case"] = c.name;
-  j["method"] = S.method;
-  j["threshold_rule"] = S.threshold_rule;
-  j["full_dofs"] = S.full_dofs;
-  j["modes"] = {{"used", S.used_modes},
-                {"model_hz", std::vector<double>(S.model_hz.data(), S.model_hz.data() + S.model_hz.size())},
-                {"changed_hz", std::vector<double>(S.changed_hz.data(), S.changed_hz.data() + S.changed_hz.size())},
-                {"mac", std::vector<double>(S.mac.data(), S.mac.data() + S.mac.size())}};
-  nlohmann::json els = nlohmann::json::array();
-  for (const ElementScore& e : S.elements) {
-    nlohmann::json x = {{"id", e.element},       {"score", S.full_dofs ? e.probability : e.probability},
-                        {"flagged", e.flagged},  {"rank", e.rank},
-                        {"pseudo", std::isnan(e.pseudo) ? nlohmann::json() : nlohmann::json(e.pseudo)},
-                        {"pseudo_rank", e.pseudo_rank}, {"chi2", e.chi2}, {"twins", e.twins}};
-    els.push_back(x);
-  }
-  nlohmann::json dofs = nlohmann::json::array();
-  for (std::size_t r = 0; r < S.dofs.size(); ++r)
-    dofs.push_back({{"dof", to_string(S.dofs[r])}, {"pseudo", S.pseudo[r]}, {"reference", S.pseudo_reference[r]},
-                    {"delta", S.delta_pseudo[r]}});
-  j["localization"] = {{"elements", els},
-                       {"dofs", dofs},
-                       {"score", S.full_dofs ? "fraction of the residual-force energy the element alone explains"
-                                             : "posterior probability that this element alone changed"},
-                       {"chi2_unchanged", S.chi2_unchanged},
-                       {"chi2_final", S.chi2_final}};
-  nlohmann::json q = nlohmann::json::array();
-  auto num = [](double v) { return std::isnan(v) ? nlohmann::json() : nlohmann::json(v); };
-  for (const ElementAmount& a : S.amounts)
-    q.push_back({{"element", a.element}, {"dk", a.dk}, {"dm", a.dm}, {"dk_first_order", a.dk_first_order},
-                 {"dm_first_order", a.dm_first_order}, {"dk_std", num(a.dk_std)}, {"dm_std", num(a.dm_std)}});
-  j["quantification"] = q;
-  j["first_order_condition"] = S.first_order_condition;
-  j["serep"] = {{"modes", S.serep_modes}, {"rank", S.serep_rank}};
-  j["localization"]["confidence_set"] = S.confidence_set;
-  j["warnings"] = S.warnings;
-  (void)model;
-  return j;
-}
 
 plot::Figure summary_figure(const Case& c, const Model& model, const DetectSummary& S) {
   plot::Figure f;
@@ -193,16 +152,9 @@ int run_detect(const DetectArgs& a, const GlobalOptions& g) {
     return 0;
   }
 
-  // The changed state: a simulation of the modified model, or measured data.
-  Model changed_m;
-  DetectOptions opt = d.options;
-  progress.update("changed state", -1);
-  const ModalData changed = detect_changed_data(c, &changed_m);
-  if (!d.changes.empty()) opt.simulated_changed = &changed_m;
-  ModalData refmeas;
-  if (!d.reference_measured_file.empty()) refmeas = read_measured_modal_data(d.reference_measured_file, d.geometry, model);
+  // The changed state (a simulation of the modified model, or measured data), then detection.
   progress.update("detect", -1);
-  const DetectSummary S = detect(model, changed, opt, d.reference_measured_file.empty() ? nullptr : &refmeas);
+  const DetectSummary S = detect_case(c);
   progress.done();
 
   if (!g.quiet) {
@@ -228,7 +180,7 @@ int run_detect(const DetectArgs& a, const GlobalOptions& g) {
     for (const std::string& w : S.warnings) fmt::print(stderr, "dynid detect: warning: {}\n", w);
   }
   if (!a.json.empty()) {
-    write_file_atomic(a.json, summary_json(c, model, S).dump(1) + "\n", a.force);
+    write_file_atomic(a.json, detect_json(c.name, S).dump(1) + "\n", a.force);
     const std::string png = a.plot.empty() ? std::filesystem::path(a.json).replace_extension(".png").string() : a.plot;
     plot::save(summary_figure(c, model, S), png, a.force);
   } else if (!a.plot.empty()) {

@@ -66,6 +66,14 @@ void print_uff(const UffFile& f) {
     } else if (const auto* u = std::get_if<UffUnits>(&ds.data)) {
       fmt::print("units {} '{}': length factor {:.6g}, force {:.6g}, temperature {:.6g}, offset {:.6g}\n", u->code,
                  u->description, u->length, u->force, u->temperature, u->temperature_offset);
+    } else if (const auto* a = std::get_if<Uff2414>(&ds.data)) {
+      fmt::print("analysis data, analysis type {}, data characteristic {}, result type {}, mode {}: {:.6g} Hz, {} nodes x {} {} values\n",
+                 a->analysis_type, a->data_characteristic, a->result_type, a->mode_number(), a->frequency_hz(), a->nodes.size(),
+                 a->values_per_node, a->complex() ? "complex" : "real");
+    } else if (const auto* cs = std::get_if<UffCoordinateSystems>(&ds.data)) {
+      int resolved = 0;
+      for (const UffCoordinateSystem& c : cs->systems) resolved += c.resolved;
+      fmt::print("{} coordinate systems ({} resolved to global axes)\n", cs->systems.size(), resolved);
     } else {
       fmt::print("skipped (dataset type not read by dynid)\n");
     }

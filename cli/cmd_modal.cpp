@@ -2,11 +2,14 @@
 // dynid export-matrices CASE DIR: the case's model as matrices (docs/matrix-input.md).
 #include <fmt/core.h>
 
+#include <filesystem>
+
 #include "commands.hpp"
 #include "dynid/engine/modal.hpp"
 #include "dynid/io/case_file.hpp"
 #include "dynid/io/matrix_model.hpp"
 #include "dynid/io/model_plots.hpp"
+#include "dynid/io/model_view.hpp"
 #include "dynid/io/output.hpp"
 #include "progress.hpp"
 
@@ -18,6 +21,7 @@ struct ModalArgs {
   int modes = 0;
   std::string json, plot;
   bool force = false;
+  std::string view;  ///< the report's 3D mode-shape data (dynid run: modal-view.json)
 };
 
 int run_modal(const ModalArgs& a, const GlobalOptions& g) {
@@ -55,7 +59,9 @@ int run_modal(const ModalArgs& a, const GlobalOptions& g) {
     if (g.verbose) fmt::print("{}", r.summary.FullReport());
   }
   if (!a.plot.empty()) refuse_existing({a.plot}, a.force);
+  if (!a.view.empty()) refuse_existing({a.view}, a.force);
   if (!a.json.empty()) write_file_atomic(a.json, modal_json(c, r).dump(1) + "\n", a.force);
+  if (!a.view.empty() && r.ok()) write_file_atomic(a.view, model_view_json(c.model, r).dump() + "\n", a.force);
   if (!a.plot.empty()) plot::save(plot::mode_shape_figure(c.model, r, 6, "dynid modal: " + c.name + " - mode shapes"), a.plot, a.force);
   if (!r.ok()) {
     fmt::print(stderr, "dynid modal: {}\n", r.summary.BriefReport());
@@ -66,7 +72,8 @@ int run_modal(const ModalArgs& a, const GlobalOptions& g) {
 }  // namespace
 
 int modal_step(const std::string& case_path, const std::string& json, const std::string& plot, bool force, const GlobalOptions& g) {
-  return run_modal(ModalArgs{case_path, 0, json, plot, force}, g);
+  const std::filesystem::path j(json);
+  return run_modal(ModalArgs{case_path, 0, json, plot, force, (j.parent_path() / (j.stem().string() + "-view.json")).string()}, g);
 }
 
 void register_modal(CLI::App& app, GlobalOptions& g) {

@@ -48,6 +48,7 @@ int run_case(const RunArgs& a, const GlobalOptions& g) {
     outputs.push_back((fs::path(dir) / (name + ".json")).string());
     outputs.push_back((fs::path(dir) / (name + ".png")).string());
   }
+  outputs.push_back((fs::path(dir) / "modal-view.json").string());  // the report's 3D mode shapes (modal_step)
   if (a.report) outputs.push_back(report_path(dir));
   refuse_existing(outputs, a.force);  // nothing is written if anything would be lost
   std::error_code ec;
@@ -64,7 +65,10 @@ int run_case(const RunArgs& a, const GlobalOptions& g) {
       return s(a.case_path, (fs::path(dir) / (n + ".json")).string(), (fs::path(dir) / (n + ".png")).string(), a.force, g);
     });
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    run["steps"].push_back({{"name", name}, {"json", name + ".json"}, {"plot", name + ".png"}, {"exit_code", rc}, {"seconds", secs}});
+    nlohmann::json entry = {{"name", name}, {"json", name + ".json"}, {"plot", name + ".png"}, {"exit_code", rc}, {"seconds", secs}};
+    std::error_code vec;
+    if (name == "modal" && fs::is_regular_file(fs::path(dir) / "modal-view.json", vec)) entry["view"] = "modal-view.json";
+    run["steps"].push_back(entry);
     if (rc != 0 && worst == 0) worst = rc;
   }
   write_file_atomic(outputs[0], run.dump(1) + "\n", a.force);

@@ -10,6 +10,7 @@
 #include "dynid/io/modal_data_io.hpp"
 #include "dynid/io/output.hpp"
 #include "dynid/io/plot.hpp"
+#include "dynid/io/results_json.hpp"
 #include "dynid/mesh/error.hpp"
 #include "progress.hpp"
 
@@ -21,42 +22,6 @@ struct UpdateArgs {
   std::string case_path, json, plot;
   bool force = false;
 };
-
-std::vector<double> vec(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
-
-nlohmann::json update_json(const Case& c, const ParametricModel& pm, const UpdateSpec& u, const FitSummary& f) {
-  auto num = [](double v) { return std::isnan(v) ? nlohmann::json() : nlohmann::json(v); };
-  nlohmann::json params = nlohmann::json::array();
-  for (int p = 0; p < pm.num_parameters(); ++p) {
-    const Parameter& q = pm.parameter(p);
-    std::string status = u.free[p] ? "free" : "fixed";
-    for (const auto& t : u.ties)
-      if (t.first == p) status = "tied to " + pm.parameter(t.second.first).name;
-    params.push_back({{"name", q.name},
-                      {"kind", std::string(parameter_kind_name(q.kind))},
-                      {"initial", u.initial[p]},
-                      {"value", f.theta[p]},
-                      {"std", num(f.stddev[p])},
-                      {"std_aposteriori", num(f.stddev[p] * f.residual_scale)},
-                      {"status", status},
-                      {"at_bound", std::find(f.at_bound.begin(), f.at_bound.end(), p) != f.at_bound.end()}});
-  }
-  nlohmann::json j;
-  j["case"] = c.name;
-  j["parameters"] = params;
-  j["frequencies_hz"] = {{"initial", vec(f.initial_hz)}, {"updated", vec(f.final_hz)}, {"measured", vec(f.measured_hz)}};
-  j["mac"] = {{"initial", vec(f.initial_mac)}, {"updated", vec(f.final_mac)}};
-  j["objective"] = std::string(fit_objective_name(u.options.objective));
-  j["iterations"] = f.iterations;
-  j["model_evaluations"] = f.evaluations;
-  j["cost"] = {{"initial", f.initial_cost}, {"final", f.final_cost}, {"history", f.cost_history}};
-  j["termination"] = f.termination;
-  j["converged"] = f.converged;
-  j["covariance"] = {{"rank", f.covariance_rank}, {"free_parameters", f.free_parameters}, {"full_rank", f.covariance_ok},
-                     {"residual_scale", num(f.residual_scale)}};
-  j["warnings"] = f.warnings;
-  return j;
-}
 
 plot::Figure update_figure(const Case& c, const ParametricModel& pm, const UpdateSpec& u, const FitSummary& f) {
   plot::Figure fig;
@@ -124,12 +89,11 @@ int run_update(const UpdateArgs& a, const GlobalOptions& g) {
   require_section(c, c.update.has_value(), "update");
   const UpdateSpec& u = *c.update;
   Progress progress(!g.quiet);
-  progress.update("measured data", -1);
-  const ModalData measured = update_measured_data(c);
-  ParametricModel pm(c.model);
-  for (const Parameter& p : u.parameters) pm.add(p);
   progress.update("updating", -1);
-  const FitSummary f = fit_parameters(pm, measured, u.initial, u.free, u.options);
+  const UpdateRun run = update_case(c);
+  const ModalData& measured = run.measured;
+  const ParametricModel& pm = *run.pm;
+  const FitSummary& f = run.fit;
   progress.done();
   if (!g.quiet) {
     fmt::print("dynid update: {} — {} parameters ({} free), {} measured modes at {} DOFs, objective {}\n", c.name,
@@ -152,7 +116,7 @@ int run_update(const UpdateArgs& a, const GlobalOptions& g) {
     for (const std::string& w : f.warnings) fmt::print(stderr, "dynid update: warning: {}\n", w);
   }
   if (!a.json.empty()) {
-    write_file_atomic(a.json, update_json(c, pm, u, f).dump(1) + "\n", a.force);
+    write_file_atomic(a.json, update_json(c.name, pm, u, f).dump(1) + "\n", a.force);
     const std::string png = a.plot.empty() ? std::filesystem::path(a.json).replace_extension(".png").string() : a.plot;
     plot::save(update_figure(c, pm, u, f), png, a.force);
   } else if (!a.plot.empty()) {

@@ -185,7 +185,7 @@ TEST(UffSamples, TestLabUnitsNodesAndSkipped) {
                                 {1, 11, 17, 164, 203, 210, 219});
   ASSERT_EQ(f.datasets.size(), 7u);
   EXPECT_TRUE(std::holds_alternative<UffSkipped>(f.datasets[0].data));
-  EXPECT_TRUE(std::holds_alternative<UffSkipped>(f.datasets[2].data));
+  EXPECT_TRUE(std::holds_alternative<UffCoordinateSystems>(f.datasets[2].data));  // 18, read since issue 18
   EXPECT_TRUE(std::holds_alternative<UffSkipped>(f.datasets[4].data));
   const UffUnits& u = std::get<UffUnits>(f.datasets[1].data);
   EXPECT_EQ(u.code, 9);

@@ -4,6 +4,8 @@
 #include "dynid/engine/identify.hpp"
 #include "dynid/io/case_file.hpp"
 #include "dynid/io/discover_io.hpp"
+#include "dynid/io/mat_file.hpp"
+#include "dynid/io/results_json.hpp"
 #include "dynid/io/modal_data_io.hpp"
 #include "dynid/io/test_data.hpp"
 #include "dynid/io/test_layout.hpp"
@@ -58,14 +60,44 @@ DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model
   DiscoverSpec d;
   const int sources = !!n["measured"] + !!n["recordings"] + !!n["truth"];
   if (sources != 1) ctx.fail(n, "discover: give exactly one of measured: FILE (modal data), recordings: [FILES] or truth: {model:, test:}");
-  if (n["measured"]) d.measured_file = resolve(dir, ctx.string(n["measured"], "discover measured"));
+  if (n["measured"]) d.measured_file = parse_measured(n["measured"], ctx, dir, "discover measured");
+  d.measured_mat = parse_measured_mat(n, "discover", ctx);
   d.geometry = parse_geometry(n, "discover", ctx, dir);
   if (n["recordings"]) {
     const YAML::Node& r = n["recordings"];
-    if (r.IsScalar()) d.recordings.push_back(resolve(dir, ctx.string(r, "discover recordings")));
+    // FILE, or {mat: FILE, data: VAR, sample_rate: VAR | sample_rate_hz: NUMBER, channels: VAR | [labels], inputs:
+    // [labels], quantity: acceleration} (a MATLAB file's variables).
+    auto one = [&](const YAML::Node& f) {
+      MatRecordingNames m;
+      if (f.IsMap()) {
+        ctx.only_keys(f, "discover recording", {"mat", "data", "sample_rate", "sample_rate_hz", "channels", "inputs", "quantity"});
+        if (!f["mat"]) ctx.fail(f, "discover recording: mat (the .mat file) is missing");
+        m.file = resolve(dir, ctx.string(f["mat"], "recording mat"));
+        if (f["data"]) m.data = ctx.string(f["data"], "recording data");
+        if (f["sample_rate"]) m.sample_rate = ctx.string(f["sample_rate"], "recording sample_rate");
+        if (f["sample_rate_hz"]) m.sample_rate_hz = ctx.number(f["sample_rate_hz"], "recording sample_rate_hz");
+        if (f["channels"]) {
+          if (f["channels"].IsSequence()) {
+            for (const auto& c : f["channels"]) m.channel_labels.push_back(ctx.string(c, "recording channel"));
+          } else {
+            m.channels = ctx.string(f["channels"], "recording channels");
+          }
+        }
+        if (f["inputs"]) {
+          ctx.require_sequence(f["inputs"], "recording inputs");
+          for (const auto& c : f["inputs"]) m.inputs.push_back(ctx.string(c, "recording input"));
+        }
+        if (f["quantity"]) m.quantity = ctx.string(f["quantity"], "recording quantity");
+        d.recordings.push_back(m.file);
+      } else {
+        d.recordings.push_back(resolve(dir, ctx.string(f, "discover recordings")));
+      }
+      d.recording_mat.push_back(m);
+    };
+    if (r.IsScalar() || r.IsMap()) one(r);
     else {
       ctx.require_sequence(r, "discover recordings");
-      for (const auto& f : r) d.recordings.push_back(resolve(dir, ctx.string(f, "discover recordings")));
+      for (const auto& f : r) one(f);
     }
   }
   if (n["identify"]) {
@@ -188,12 +220,37 @@ ModalData keep_modes(ModalData m, const DiscoverSpec& d, std::vector<std::string
 }
 }  // namespace
 
+namespace {
+// Identification of the recordings of a discover: case (the band the model implies unless the case gives one).
+void identify_recordings_for(const Case& c, std::vector<Recording> recs, DiscoveryData* out) {
+  const DiscoverSpec& d = *c.discover;
+  const std::string method = d.truth ? (d.method.empty() ? d.truth_test->method : d.method) : d.method;
+  IdentificationOptions io = d.identify;
+  if (d.truth && d.identify.band_hi_hz == 0 && d.identify.max_order == 0) io = d.truth_test->identify;
+  if (d.identify.band_hi_hz == 0 && !recs.empty()) {
+    // One rule for every case: the band the analysis model implies for these sensors (band_from_model).
+    std::vector<MeasuredDof> sensors;
+    for (const Recording& r : recs)
+      for (int ch : r.output_channels()) sensors.push_back(r.channels[static_cast<std::size_t>(ch)].dof);
+    const ModelBand b = band_from_model(c.model, sensors, recs[0].sample_rate_hz / 2);
+    io.band_lo_hz = b.lo_hz;
+    io.band_hi_hz = b.hi_hz;
+    out->notes.push_back("identification band " + format_number(b.lo_hz, 4) + " to " + format_number(b.hi_hz, 4) + " Hz, from the " +
+                         std::to_string(b.visible_hz.size()) + " lowest modes of the model the sensors see (" +
+                         format_number(b.visible_hz.front(), 4) + " to " + format_number(b.visible_hz.back(), 4) + " Hz)");
+  }
+  out->identification = identify_recordings(std::move(recs), method, io);
+  out->identified = true;
+  out->measured = out->identification.modal_data("identified from " + out->source);
+}
+}  // namespace
+
 DiscoveryData discovery_data(const Case& c, int seed_offset) {
   require_section(c, c.discover.has_value(), "discover");
   const DiscoverSpec& d = *c.discover;
   DiscoveryData out;
   if (!d.measured_file.empty()) {
-    out.measured = read_measured_modal_data(d.measured_file, d.geometry, c.model, &out.notes);
+    out.measured = read_measured_modal_data(d.measured_file, d.geometry, c.model, &out.notes, d.measured_mat);
     out.source = d.measured_file;
   } else {
     std::vector<Recording> recs;
@@ -204,36 +261,45 @@ DiscoveryData discovery_data(const Case& c, int seed_offset) {
       out.truth_modes = std::move(vt.modes);
       out.source = "virtual test of the truth model (seed " + std::to_string(d.truth_test->options.seed + static_cast<std::uint64_t>(seed_offset)) + ")";
     } else {
-      // Any layout (one file per channel, per test, per hit): grouped into tests (io/test_layout.hpp).
-      const TestSet set = read_test_set(d.recordings);
-      if (set.kind != TestSet::Kind::kRecordings)
-        throw InputError(d.recordings[0] + (d.recordings.size() > 1 ? " ..." : "") + ": discover: recordings: needs time recordings (UFF 58 type 1, text or LabVIEW time tables); these hold " +
-                         (set.kind == TestSet::Kind::kFrf ? "FRFs" : "a spectrum"));
-      set.require_consistent();
-      recs = set.recordings();
-      out.notes.insert(out.notes.end(), set.notes.begin(), set.notes.end());
+      // .mat files by their named variables; every other file in any layout (one file per channel, per test,
+      // per hit), grouped into tests (io/test_layout.hpp).
+      std::vector<std::string> files;
+      for (std::size_t k = 0; k < d.recordings.size(); ++k) {
+        if (k < d.recording_mat.size() && !d.recording_mat[k].file.empty()) recs.push_back(read_mat_recording(d.recording_mat[k]));
+        else files.push_back(d.recordings[k]);
+      }
+      if (!files.empty()) {
+        const TestSet set = read_test_set(files);
+        if (set.kind != TestSet::Kind::kRecordings)
+          throw InputError(files[0] + (files.size() > 1 ? " ..." : "") + ": discover: recordings: needs time recordings (UFF 58 type 1, text or LabVIEW time tables); these hold " +
+                           (set.kind == TestSet::Kind::kFrf ? "FRFs" : "a spectrum"));
+        set.require_consistent();
+        for (Recording& r : set.recordings()) recs.push_back(std::move(r));
+        out.notes.insert(out.notes.end(), set.notes.begin(), set.notes.end());
+      }
       out.source = d.recordings[0] + (d.recordings.size() > 1 ? " ..." : "");
     }
-    const std::string method = d.truth ? (d.method.empty() ? d.truth_test->method : d.method) : d.method;
-    IdentificationOptions io = d.identify;
-    if (d.truth && d.identify.band_hi_hz == 0 && d.identify.max_order == 0) io = d.truth_test->identify;
-    if (d.identify.band_hi_hz == 0 && !recs.empty()) {
-      // One rule for every case: the band the analysis model implies for these sensors (band_from_model).
-      std::vector<MeasuredDof> sensors;
-      for (const Recording& r : recs)
-        for (int ch : r.output_channels()) sensors.push_back(r.channels[static_cast<std::size_t>(ch)].dof);
-      const ModelBand b = band_from_model(c.model, sensors, recs[0].sample_rate_hz / 2);
-      io.band_lo_hz = b.lo_hz;
-      io.band_hi_hz = b.hi_hz;
-      out.notes.push_back("identification band " + format_number(b.lo_hz, 4) + " to " + format_number(b.hi_hz, 4) + " Hz, from the " +
-                          std::to_string(b.visible_hz.size()) + " lowest modes of the model the sensors see (" +
-                          format_number(b.visible_hz.front(), 4) + " to " + format_number(b.visible_hz.back(), 4) + " Hz)");
-    }
-    out.identification = identify_recordings(std::move(recs), method, io);
-    out.identified = true;
-    out.measured = out.identification.modal_data("identified from " + out.source);
+    identify_recordings_for(c, std::move(recs), &out);
   }
   out.measured = keep_modes(std::move(out.measured), d, &out.notes);
+  return out;
+}
+
+DiscoveryData discovery_data(const Case& c, ModalData measured, const std::string& source) {
+  require_section(c, c.discover.has_value(), "discover");
+  DiscoveryData out;
+  out.source = source;
+  out.measured = keep_modes(std::move(measured), *c.discover, &out.notes);
+  return out;
+}
+
+DiscoveryData discovery_data(const Case& c, std::vector<Recording> recordings, const std::string& source) {
+  require_section(c, c.discover.has_value(), "discover");
+  if (recordings.empty()) throw InputError(c.path + ": discover: no recordings given");
+  DiscoveryData out;
+  out.source = source;
+  identify_recordings_for(c, std::move(recordings), &out);
+  out.measured = keep_modes(std::move(out.measured), *c.discover, &out.notes);
   return out;
 }
 

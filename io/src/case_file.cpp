@@ -66,6 +66,29 @@ std::vector<MeasuredDof> parse_dof_selection(const YAML::Node& n, const YamlCtx&
   return out;
 }
 
+std::string parse_measured(const YAML::Node& n, const YamlCtx& ctx, const std::string& dir, const std::string& what) {
+  if (!n.IsMap()) return resolve(dir, ctx.string(n, what));
+  ctx.only_keys(n, what, {"mat", "frequency_hz", "eigenvalues", "shapes", "dofs", "damping"});
+  if (!n["mat"]) ctx.fail(n, what + ": mat (the .mat file) is missing; give measured: FILE or {mat: FILE, shapes: VAR, ...}");
+  if (n["frequency_hz"] && n["eigenvalues"]) ctx.fail(n, what + ": give frequency_hz or eigenvalues, not both");
+  return resolve(dir, ctx.string(n["mat"], what + " mat"));
+}
+
+MatModalNames parse_measured_mat(const YAML::Node& section, const std::string& name, const YamlCtx& ctx) {
+  MatModalNames names;
+  const YAML::Node m = section["measured"];
+  if (!m || !m.IsMap()) return names;
+  auto var = [&](const char* k, std::string* out) {
+    if (m[k]) *out = ctx.string(m[k], name + " measured " + k + " (a variable name)");
+  };
+  var("frequency_hz", &names.frequency_hz);
+  var("eigenvalues", &names.eigenvalues);
+  var("shapes", &names.shapes);
+  var("dofs", &names.dofs);
+  var("damping", &names.damping);
+  return names;
+}
+
 GeometrySpec parse_geometry(const YAML::Node& section, const std::string& name, const YamlCtx& ctx, const std::string& dir) {
   GeometrySpec g;
   const YAML::Node n = section["geometry"];
@@ -204,7 +227,8 @@ DetectSpec parse_detect(const YAML::Node& n, const YamlCtx& ctx, const Model& mo
     }
     d.measured_dofs = n["measured_dofs"] ? parse_dof_selection(n["measured_dofs"], ctx, model, "measured_dofs") : all_dofs(model);
   } else {
-    d.measured_file = resolve(dir, ctx.string(n["measured"], "measured"));
+    d.measured_file = parse_measured(n["measured"], ctx, dir, "detect measured");
+    d.measured_mat = parse_measured_mat(n, "detect", ctx);
     if (n["measured_dofs"]) ctx.fail(n["measured_dofs"], "detect: measured_dofs is for simulations; measured data carry their own DOFs");
   }
   if (n["reference_measured"]) d.reference_measured_file = resolve(dir, ctx.string(n["reference_measured"], "reference_measured"));
@@ -262,6 +286,17 @@ std::string resolve_case_path(const std::string& path) {
   return path;
 }
 
+namespace {
+// The sections after model: (analysis, detect, update, test, discover), parsed against c->model.
+void parse_sections(const YAML::Node& root, const YamlCtx& ctx, Case* c) {
+  c->analysis = parse_analysis(root["analysis"], ctx);
+  if (root["detect"]) c->detect = parse_detect(root["detect"], ctx, c->model, c->dir);
+  if (root["update"]) c->update = internal::parse_update(root["update"], ctx, c->model, c->dir);
+  if (root["test"]) c->test = internal::parse_test(root["test"], ctx, c->model, c->dir);
+  if (root["discover"]) c->discover = internal::parse_discover(root["discover"], ctx, c->model, c->dir);
+}
+}  // namespace
+
 Case parse_case(const std::string& text, const std::string& name, const std::string& dir) {
   YamlCtx ctx{name};
   YAML::Node root;
@@ -286,11 +321,29 @@ Case parse_case(const std::string& text, const std::string& name, const std::str
     const YAML::Node m = internal::model_node(root, &mctx, &mdir, 0);
     c.model = internal::parse_model(m, mctx, mdir, &c.notes);
   }
-  c.analysis = parse_analysis(root["analysis"], ctx);
-  if (root["detect"]) c.detect = parse_detect(root["detect"], ctx, c.model, dir);
-  if (root["update"]) c.update = internal::parse_update(root["update"], ctx, c.model, dir);
-  if (root["test"]) c.test = internal::parse_test(root["test"], ctx, c.model, dir);
-  if (root["discover"]) c.discover = internal::parse_discover(root["discover"], ctx, c.model, dir);
+  parse_sections(root, ctx, &c);
+  return c;
+}
+
+Case case_with_model(Model model, const std::string& text, const std::string& name, const std::string& dir) {
+  if (!model.finalized()) throw InputError(name + ": the model is not finalized (call finalize() first)");
+  YamlCtx ctx{name};
+  YAML::Node root;
+  try {
+    root = YAML::Load(text.empty() ? std::string("{}") : text);
+  } catch (const YAML::ParserException& e) {
+    throw InputError(name + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) + ": malformed: " + e.msg);
+  }
+  if (!root || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
+  ctx.require_map(root, "case sections");
+  ctx.only_keys(root, "the case sections", {"name", "description", "analysis", "detect", "update", "test", "discover"});
+  Case c;
+  c.path = name;
+  c.dir = dir;
+  c.name = root["name"] ? ctx.string(root["name"], "name") : name;
+  if (root["description"]) c.description = ctx.string(root["description"], "description");
+  c.model = std::move(model);
+  parse_sections(root, ctx, &c);
   return c;
 }
 
@@ -309,7 +362,7 @@ ModalData simulate(const Model& m, const std::vector<MeasuredDof>& dofs, int cou
 ModalData detect_changed_data(const Case& c, Model* changed) {
   require_section(c, c.detect.has_value(), "detect");
   const DetectSpec& d = *c.detect;
-  if (!d.measured_file.empty()) return read_measured_modal_data(d.measured_file, d.geometry, c.model);
+  if (!d.measured_file.empty()) return read_measured_modal_data(d.measured_file, d.geometry, c.model, nullptr, d.measured_mat);
   Model local;
   Model& m = changed ? *changed : local;  // the caller may not want the changed model
   m = changed_model(c.model, d.changes);
@@ -320,14 +373,19 @@ ModalData update_measured_data(const Case& c) {
   require_section(c, c.update.has_value(), "update");
   const UpdateSpec& u = *c.update;
   ModalData m = !u.measured_file.empty()
-                    ? read_measured_modal_data(u.measured_file, u.geometry, c.model)
+                    ? read_measured_modal_data(u.measured_file, u.geometry, c.model, nullptr, u.measured_mat)
                     : simulate(apply_factors(c.model, u.target_changes), u.measured_dofs, u.target_modes,
                                "simulated target of " + c.name);
-  if (u.modes > 0 && u.modes < m.num_modes()) {
-    m.frequencies_hz.conservativeResize(u.modes);
-    m.shapes.conservativeResize(Eigen::NoChange, u.modes);
-    if (m.damping_ratios.size() > u.modes) m.damping_ratios.conservativeResize(u.modes);
-  }
+  return first_modes(std::move(m), u.modes);
+}
+
+ModalData first_modes(ModalData m, int count) {
+  if (count <= 0 || count >= m.num_modes()) return m;
+  m.frequencies_hz.conservativeResize(count);
+  m.shapes.conservativeResize(Eigen::NoChange, count);
+  // Every per-mode vector given (identified data carry damping, MPC and standard deviations) is cut alike.
+  for (Eigen::VectorXd* v : {&m.damping_ratios, &m.mpc, &m.frequency_std_hz, &m.damping_std, &m.shape_std})
+    if (v->size() > count) v->conservativeResize(count);
   return m;
 }
 

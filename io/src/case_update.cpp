@@ -48,7 +48,8 @@ UpdateSpec parse_update(const YAML::Node& n, const YamlCtx& ctx, const Model& mo
   FitOptions& o = u.options;
   if (n["measured"] && n["target"]) ctx.fail(n, "update: give either measured: (a file) or target: (a simulation), not both");
   if (!n["measured"] && !n["target"]) ctx.fail(n, "update: the measured data are missing: give measured: FILE or target: {...}");
-  if (n["measured"]) u.measured_file = resolve(dir, ctx.string(n["measured"], "measured"));
+  if (n["measured"]) u.measured_file = parse_measured(n["measured"], ctx, dir, "update measured");
+  u.measured_mat = parse_measured_mat(n, "update", ctx);
   u.geometry = internal::parse_geometry(n, "update", ctx, dir);
   if (n["target"]) {
     const YAML::Node& t = n["target"];

@@ -31,6 +31,19 @@ nlohmann::ordered_json identification_json(const IdentificationSummary& s) {
     if (m.twin_of >= 0) modes[k]["same_shape_as"] = {{"mode", m.twin_of + 1}, {"mac", m.twin_mac}};
   }
   j["modes"] = modes;
+  // The stabilization diagram (the report draws it zoomable): every pole as [order, frequency, damping, class,
+  // mode] (class 0 new or unstable, 1 stable in frequency, 2 and in damping, 3 and in vector; mode = the selected
+  // mode it supports, 0 none), and the spectrum behind it.
+  nlohmann::ordered_json poles = nlohmann::ordered_json::array();
+  for (const StabilizationPole& p : s.poles) {
+    if (!p.physical) continue;
+    const int cls = !p.stable_frequency ? 0 : !p.stable_damping ? 1 : !p.stable_vector ? 2 : 3;
+    poles.push_back({p.order, p.frequency_hz, p.damping_ratio, cls, p.cluster + 1});
+  }
+  j["stabilization"] = {{"poles", poles},
+                        {"frequency_hz", std::vector<double>(s.frequency_hz.data(), s.frequency_hz.data() + s.frequency_hz.size())},
+                        {"background", std::vector<double>(s.background.data(), s.background.data() + s.background.size())},
+                        {"background_label", s.background_label}};
   nlohmann::ordered_json rejected = nlohmann::ordered_json::array();
   for (const RejectedCluster& r : s.rejected) {
     nlohmann::ordered_json x;

@@ -219,21 +219,60 @@ void add_matrix_model(const MatrixModelFiles& files, Model* model, std::vector<s
   if (files.elements.empty() && files.groups.empty())
     throw InputError("matrix model: give element matrices (elements:) or group matrices (groups:)");
   if (files.K.empty() != files.M.empty()) throw InputError("matrix model: give both K and M, or neither");
-  const std::vector<DofRow> dofs = parse_dof_table(internal::read_file_bytes(files.dofs), files.dofs);
+  MatrixModelData d;
+  d.dofs = parse_dof_table(internal::read_file_bytes(files.dofs), files.dofs);
+  d.dofs_name = files.dofs;
+  d.nodes = parse_node_table(internal::read_file_bytes(files.nodes), files.nodes);
+  d.nodes_name = files.nodes;
+  const int n = static_cast<int>(d.dofs.size());
+  if (!files.elements.empty()) d.elements = parse_element_matrices(internal::read_file_bytes(files.elements), files.elements, n);
+  for (const MatrixModelFiles::Group& g : files.groups) {
+    if (g.K.empty() || g.M.empty()) throw InputError("matrix model: group '" + g.name + "' needs both K and M files");
+    d.groups.push_back({g.name, g.K, g.M, read_matrix_market(g.K), read_matrix_market(g.M)});
+  }
+  if (!files.K.empty()) {
+    d.has_assembled = true;
+    d.K = read_matrix_market(files.K);
+    d.K_name = files.K;
+    d.M = read_matrix_market(files.M);
+    d.M_name = files.M;
+  }
+  add_matrix_model(d, model, notes);
+}
+
+void add_matrix_model(const MatrixModelData& data, Model* model, std::vector<std::string>* notes) {
+  const std::vector<DofRow>& dofs = data.dofs;
   const int n = static_cast<int>(dofs.size());
-  const std::vector<Node> nodes = parse_node_table(internal::read_file_bytes(files.nodes), files.nodes);
+  if (n == 0) throw InputError("matrix model: " + data.dofs_name + " lists no DOFs");
+  if (data.elements.empty() && data.groups.empty())
+    throw InputError("matrix model: give element matrices or group matrices");
+  {
+    std::set<std::pair<int, int>> seen;
+    for (std::size_t i = 0; i < dofs.size(); ++i)
+      if (!seen.insert({dofs[i].node, static_cast<int>(dofs[i].dof)}).second)
+        throw InputError(data.dofs_name + ": equation " + std::to_string(i + 1) + " is " + std::string(dof_name(dofs[i].dof)) +
+                         " at node " + std::to_string(dofs[i].node) + ", which an earlier equation already is");
+  }
   std::set<int> node_ids;
-  for (const Node& nd : nodes) node_ids.insert(nd.id);
+  for (const Node& nd : data.nodes) node_ids.insert(nd.id);
   for (std::size_t i = 0; i < dofs.size(); ++i)
     if (!node_ids.count(dofs[i].node))
-      throw InputError(files.dofs + ": equation " + std::to_string(i + 1) + " is at node " + std::to_string(dofs[i].node) +
-                       ", which " + files.nodes + " does not list");
+      throw InputError(data.dofs_name + ": equation " + std::to_string(i + 1) + " is at node " + std::to_string(dofs[i].node) +
+                       ", which " + data.nodes_name + " does not list");
 
-  std::vector<ElementMatrices> elems;
-  if (!files.elements.empty())
-    elems = parse_element_matrices(internal::read_file_bytes(files.elements), files.elements, n);
+  std::vector<ElementMatrices> elems = data.elements;
   int next_id = 1;
-  for (const ElementMatrices& e : elems) next_id = std::max(next_id, e.id + 1);
+  for (const ElementMatrices& e : elems) {
+    for (int q : e.equations)
+      if (q < 0 || q >= n)
+        throw InputError("matrix model: element " + std::to_string(e.id) + ": equation " + std::to_string(q + 1) +
+                         " is not one of the " + std::to_string(n) + " equations of " + data.dofs_name);
+    const auto m = static_cast<Eigen::Index>(e.equations.size());
+    if (e.K.rows() != m || e.K.cols() != m || e.M.rows() != m || e.M.cols() != m)
+      throw InputError("matrix model: element " + std::to_string(e.id) + ": K and M must be " + std::to_string(m) + " x " +
+                       std::to_string(m) + " (one row per DOF)");
+    next_id = std::max(next_id, e.id + 1);
+  }
   // A sparse matrix on the global equations as one dense element on the equations it touches.
   auto dense_element = [&](const SparseMatrix& K, const SparseMatrix& M, const std::string& what) {
     ElementMatrices e;
@@ -253,39 +292,43 @@ void add_matrix_model(const MatrixModelFiles& files, Model* model, std::vector<s
     for (int k = 0; k < m; ++k) local[e.equations[k]] = k;
     e.K = Eigen::MatrixXd::Zero(m, m);
     e.M = e.K;
-    for (int j = 0; j < n; ++j) {
+    for (int j = 0; j < K.outerSize(); ++j)
       for (SparseMatrix::InnerIterator it(K, j); it; ++it)
         if (it.value() != 0.0) e.K(local[it.row()], local[j]) += it.value();
+    for (int j = 0; j < M.outerSize(); ++j)
       for (SparseMatrix::InnerIterator it(M, j); it; ++it)
         if (it.value() != 0.0) e.M(local[it.row()], local[j]) += it.value();
-    }
     return e;
   };
-  auto read_square = [&](const std::string& path) {
-    SparseMatrix A = read_matrix_market(path);
+  // A square symmetric matrix on the n equations (0 x 0: none, zero).
+  auto check_square = [&](const SparseMatrix& A, const std::string& name) {
+    if (A.rows() == 0 && A.cols() == 0) return SparseMatrix(n, n);
     if (A.rows() != n || A.cols() != n)
-      throw InputError(path + ": a " + std::to_string(A.rows()) + " x " + std::to_string(A.cols()) +
-                       " matrix, but the DOF table " + files.dofs + " has " + std::to_string(n) + " equations");
+      throw InputError(name + ": a " + std::to_string(A.rows()) + " x " + std::to_string(A.cols()) +
+                       " matrix, but the DOF table " + data.dofs_name + " has " + std::to_string(n) + " equations");
     const SparseMatrix At = A.transpose();
     const double scale = std::max(1e-300, norm1(A));
     for (int j = 0; j < n; ++j)
-      for (SparseMatrix::InnerIterator it(A, j); it; ++it)
+      for (SparseMatrix::InnerIterator it(A, j); it; ++it) {
+        if (!std::isfinite(it.value()))
+          throw InputError(name + ": entry (" + std::to_string(it.row() + 1) + ", " + std::to_string(j + 1) + ") is not finite");
         if (std::abs(it.value() - At.coeff(it.row(), j)) > 1e-12 * scale)
-          throw InputError(path + ": not symmetric: entries (" + std::to_string(it.row() + 1) + ", " + std::to_string(j + 1) +
+          throw InputError(name + ": not symmetric: entries (" + std::to_string(it.row() + 1) + ", " + std::to_string(j + 1) +
                            ") and (" + std::to_string(j + 1) + ", " + std::to_string(it.row() + 1) + ") differ");
+      }
     return A;
   };
-  for (const MatrixModelFiles::Group& g : files.groups) {
-    if (g.K.empty() || g.M.empty()) throw InputError("matrix model: group '" + g.name + "' needs both K and M files");
-    ElementMatrices e = dense_element(read_square(g.K), read_square(g.M), "group '" + g.name + "' (" + g.K + ")");
+  for (const MatrixModelData::Group& g : data.groups) {
+    ElementMatrices e = dense_element(check_square(g.K, g.K_name), check_square(g.M, g.M_name),
+                                      "group '" + g.name + "' (" + g.K_name + ")");
     e.group = g.name;
     elems.push_back(std::move(e));
   }
 
   // The assembled matrices, if given: the elements must add up to them; what they hold beyond the elements
   // (entries that differ by more than rounding) becomes one remainder element.
-  if (!files.K.empty()) {
-    const SparseMatrix K = read_square(files.K), M = read_square(files.M);
+  if (data.has_assembled) {
+    const SparseMatrix K = check_square(data.K, data.K_name), M = check_square(data.M, data.M_name);
     std::vector<Eigen::Triplet<double, int>> tk, tm, ta;
     for (const ElementMatrices& e : elems) {
       const int m = static_cast<int>(e.equations.size());
@@ -317,17 +360,17 @@ void add_matrix_model(const MatrixModelFiles& files, Model* model, std::vector<s
     double wk = 0, wm = 0;
     const SparseMatrix RK = difference(K, SK, &wk), RM = difference(M, SM, &wm);
     if (RK.nonZeros() + RM.nonZeros() > 0) {
-      ElementMatrices e = dense_element(RK, RM, "the part of " + files.K + " / " + files.M + " that the element matrices do not hold");
+      ElementMatrices e = dense_element(RK, RM, "the part of " + data.K_name + " / " + data.M_name + " that the element matrices do not hold");
       e.group = "remainder";
       if (notes)
-        notes->push_back(files.K + " / " + files.M + " hold more than the element matrices on " +
+        notes->push_back(data.K_name + " / " + data.M_name + " hold more than the element matrices on " +
                          std::to_string(e.equations.size()) + " DOFs (largest relative difference " + fmt(std::max(wk, wm)) +
                          "): added as matrix element " + std::to_string(e.id) + " (group remainder)");
       elems.push_back(std::move(e));
     }
   }
 
-  for (const Node& nd : nodes) model->add_node(nd.id, nd.x);
+  for (const Node& nd : data.nodes) model->add_node(nd.id, nd.x);
   for (ElementMatrices& e : elems) {
     MatrixElementData d;
     for (int q : e.equations) d.dofs.emplace_back(dofs[q].node, dofs[q].dof);

@@ -6,6 +6,7 @@
 #include <regex>
 #include <set>
 
+#include "dynid/io/mat_file.hpp"
 #include "dynid/io/matrix_model.hpp"
 #include "dynid/io/mesh_files.hpp"
 #include "dynid/io/limits.hpp"
@@ -330,8 +331,62 @@ struct Parser {
 
   /// model: {matrices: {dofs, nodes, elements, groups: {name: {K, M}}, K, M}}: a model exported from another FE
   /// code as matrices (docs/matrix-input.md); its elements are Matrix elements.
+  /// model: {matrices: {mat: FILE, K: VAR, M: VAR, groups: [VAR, ...] | {name: VAR | {K: VAR, M: VAR}},
+  /// elements: {K: VAR, M: VAR, dofs: VAR, groups: VAR}, dofs: VAR, nodes: VAR}}: the same from a MATLAB file,
+  /// every part named by its variable (docs/matrix-input.md).
+  void read_mat_matrices(const YAML::Node& m) {
+    ctx.only_keys(m, "model matrices (mat)", {"mat", "dofs", "nodes", "elements", "groups", "K", "M"});
+    MatModelNames n;
+    n.file = resolve(dir, ctx.string(m["mat"], "matrices mat"));
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(n.file, ec)) fail(m["mat"], "matrices mat: cannot open '" + n.file + "'");
+    auto var = [&](const YAML::Node& v, const std::string& w) { return ctx.string(v, w + " (a variable name)"); };
+    if (!m["K"] != !m["M"]) fail(m, "model matrices: give both K and M (the assembled matrices), or neither");
+    if (m["K"]) {
+      n.K = var(m["K"], "matrices K");
+      n.M = var(m["M"], "matrices M");
+    }
+    if (m["dofs"]) n.dofs = var(m["dofs"], "matrices dofs");
+    if (m["nodes"]) n.nodes = var(m["nodes"], "matrices nodes");
+    if (m["groups"]) {
+      const YAML::Node& g = m["groups"];
+      if (g.IsSequence()) {
+        for (const auto& v : g) {
+          const std::string k = var(v, "matrices groups");
+          n.groups.push_back({k, k, ""});
+        }
+      } else {
+        ctx.require_map(g, "matrices groups");
+        for (const auto& kv : g) {
+          const std::string name = kv.first.Scalar(), w = "matrices group '" + name + "'";
+          if (kv.second.IsScalar()) {
+            n.groups.push_back({name, var(kv.second, w), ""});
+          } else {
+            ctx.require_map(kv.second, w);
+            ctx.only_keys(kv.second, w, {"K", "M"});
+            if (!kv.second["K"]) fail(kv.second, w + ": K (a variable name) is missing");
+            n.groups.push_back({name, var(kv.second["K"], w + " K"), kv.second["M"] ? var(kv.second["M"], w + " M") : ""});
+          }
+        }
+      }
+    }
+    if (m["elements"]) {
+      const YAML::Node& e = m["elements"];
+      ctx.require_map(e, "matrices elements");
+      ctx.only_keys(e, "matrices elements", {"K", "M", "dofs", "groups"});
+      if (!e["K"] || !e["dofs"]) fail(e, "matrices elements: K and dofs (cell arrays) are needed");
+      n.element_K = var(e["K"], "elements K");
+      n.element_dofs = var(e["dofs"], "elements dofs");
+      if (e["M"]) n.element_M = var(e["M"], "elements M");
+      if (e["groups"]) n.element_groups = var(e["groups"], "elements groups");
+    }
+    if (n.groups.empty() && n.element_K.empty()) fail(m, "model matrices: name groups (group stiffness variables) or elements (cell arrays)");
+    add_matrix_model(read_mat_matrix_model(n, notes), &model, notes);
+  }
+
   void read_matrices(const YAML::Node& m) {
     ctx.require_map(m, "model matrices");
+    if (m["mat"]) return read_mat_matrices(m);
     ctx.only_keys(m, "model matrices", {"dofs", "nodes", "elements", "groups", "K", "M"});
     for (const char* k : {"dofs", "nodes"})
       if (!m[k]) fail(m, std::string("model matrices: '") + k + "' is missing (" +

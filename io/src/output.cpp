@@ -45,9 +45,11 @@ void write_file_atomic(const std::string& path, const std::string& content, bool
   }
 }
 
-nlohmann::json modal_json(const Case& c, const ModalResult& r) {
+nlohmann::json modal_json(const Case& c, const ModalResult& r) { return modal_json(c.name, r); }
+
+nlohmann::json modal_json(const std::string& name, const ModalResult& r) {
   nlohmann::json j;
-  j["case"] = c.name;
+  j["case"] = name;
   j["dofs"] = r.dofs;
   j["nonzeros"] = r.nonzeros;
   nlohmann::json modes = nlohmann::json::array();

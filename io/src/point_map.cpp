@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <limits>
 
+#include "dynid/io/mat_file.hpp"
 #include "dynid/io/modal_data_io.hpp"
 #include "dynid/mesh/error.hpp"
 #include "internal/text_util.hpp"
@@ -36,6 +37,10 @@ std::map<int, int> map_test_points(const Model& model, const UffFile& geometry, 
   std::map<int, int> out, taken;  // point -> node id; node id -> point
   double worst = 0;
   for (const UffNode& p : points) {
+    if (spec.by_position && !p.global)
+      throw InputError(src + ": test point " + std::to_string(p.id) + " is given in coordinate system " + std::to_string(p.definition_cs) +
+                       ", which the file does not define (dataset 18 or 2420): its global position is unknown; add the "
+                       "coordinate system to the file or match by id (geometry: match: id)");
     const Eigen::Vector3d x = length * p.x;
     int node = -1;
     double dist = std::numeric_limits<double>::infinity();
@@ -83,10 +88,30 @@ void relabel_points(const std::map<int, int>& map, const std::string& source, Mo
 }
 
 ModalData read_measured_modal_data(const std::string& file, const GeometrySpec& geometry, const Model& model,
-                                   std::vector<std::string>* notes) {
+                                   std::vector<std::string>* notes, const MatModalNames& mat) {
   const std::string ext = std::filesystem::path(file).extension().string();
-  ModalData d = ext == ".json" ? read_modal_data(file) : uff_modal_data(read_uff(file));
-  if (!geometry.file.empty()) relabel_points(map_test_points(model, read_uff(geometry.file), geometry, notes), file, &d);
+  if (ext == ".mat") {
+    MatModalNames names = mat;
+    names.file = file;
+    ModalData d = read_mat_modal_data(names);
+    if (!geometry.file.empty()) relabel_points(map_test_points(model, read_uff(geometry.file), geometry, notes), file, &d);
+    return d;
+  }
+  if (ext == ".json") {
+    ModalData d = read_modal_data(file);
+    if (!geometry.file.empty()) relabel_points(map_test_points(model, read_uff(geometry.file), geometry, notes), file, &d);
+    return d;
+  }
+  UffFile data = read_uff(file);
+  if (geometry.file.empty()) {
+    if (notes) notes->insert(notes->end(), data.notes.begin(), data.notes.end());
+    return uff_modal_data(data);
+  }
+  const UffFile geo = read_uff(geometry.file);
+  uff_apply_coordinate_systems(&data, geo);  // shape directions in the geometry's local systems, turned to global
+  if (notes) notes->insert(notes->end(), data.notes.begin(), data.notes.end());
+  ModalData d = uff_modal_data(data);
+  relabel_points(map_test_points(model, geo, geometry, notes), file, &d);
   return d;
 }
 

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "dynid/mesh/error.hpp"
+#include "internal/report_interactive.hpp"
 #include "internal/text_util.hpp"
 
 namespace fs = std::filesystem;
@@ -196,7 +197,9 @@ const char* kStyle = R"(body{font-family:sans-serif;max-width:1500px;margin:1em 
 h1{margin-bottom:0.2em} h2{border-bottom:2px solid #346;padding-bottom:0.2em;margin-top:1.6em}
 table{border-collapse:collapse;margin:0.5em 0 1em} th,td{border:1px solid #bbb;padding:2px 8px;text-align:right}
 th{background:#e8eef4} img{max-width:100%;border:1px solid #ccc;margin:0.5em 0} .meta{color:#666}
-nav a{margin-right:1em} .rc{color:#a00})";
+nav a{margin-right:1em} .rc{color:#a00}
+.plot{width:100%;min-height:380px;margin:0.5em 0} .view3d{margin:0.5em 0} .view3d canvas{border:1px solid #ccc;max-width:100%}
+.view3d .controls{margin:0.3em 0} .hint{color:#666;font-size:90%})";
 
 }  // namespace
 
@@ -223,7 +226,9 @@ std::string html_report(const std::string& dir) {
   try {
     const std::string name = run.value("case", std::string("?"));
     std::string body, nav;
-    int images = 0;
+    int images = 0, plots = 0, views = 0;
+    std::string unavailable;
+    const bool interactive = internal::interactive_available(&unavailable);
     static const std::vector<std::pair<std::string, std::string>> titles = {
         {"modal", "Modal analysis: mode shapes on the structure"},
         {"detect", "Detection: residual forces, localization and quantification (the paper's method)"},
@@ -253,6 +258,18 @@ std::string html_report(const std::string& dir) {
         }
         if (j.contains("warnings"))
           for (json w : j["warnings"]) body += "<p class=\"rc\">warning: " + esc(str(w)) + "</p>\n";
+        if (interactive) {
+          // The animated 3D mode shapes (modal-view.json beside modal.json) and the zoomable plots.
+          const fs::path vp = step_file(d, manifest, st, "view");
+          if (!vp.empty() && fs::is_regular_file(vp, ec)) {
+            const json v = read_json(vp);
+            if (v.is_object() && v.contains("points") && v.contains("segments") && v.contains("modes"))
+              body += "<h3>Mode shapes in 3D</h3>\n" + internal::view_block(v, views++);
+            else
+              body += "<p class=\"rc\">" + esc(vp.filename().string()) + " is not a mode-shape view.</p>\n";
+          }
+          for (const json& fig : internal::step_plots(step, j)) body += internal::plot_block(fig, plots++);
+        }
       } else {
         body += "<p class=\"rc\">No results (" + esc(jp.filename().string()) + " is missing).</p>\n";
       }
@@ -264,11 +281,16 @@ std::string html_report(const std::string& dir) {
       }
       body += "</section>\n";
     }
-    std::string html = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>dynid report: " + esc(name) +
+    std::string html = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<meta http-equiv=\"Content-Security-Policy\" content=\"" +
+                       std::string(internal::content_security_policy()) + "\">\n<title>dynid report: " + esc(name) +
                        "</title>\n<style>" + kStyle + "</style></head>\n<body data-images=\"" + std::to_string(images) +
+                       "\" data-plots=\"" + std::to_string(plots) + "\" data-views=\"" + std::to_string(views) +
                        "\">\n<h1>dynid report: " + esc(name) + "</h1>\n<p class=\"meta\">" + esc(run.value("description", std::string())) +
                        "<br>case " + esc(run.value("case_path", std::string())) + " &middot; " +
-                       esc(run.value("dynid", std::string())) + "</p>\n<nav>" + nav + "</nav>\n" + body;
+                       esc(run.value("dynid", std::string())) + "</p>\n" +
+                       (interactive ? std::string() : "<p class=\"rc\">Interactive views left out: " + esc(unavailable) + ".</p>\n") +
+                       "<nav>" + nav + "</nav>\n" + body;
+    if (plots + views > 0) html += internal::interactive_assets() + internal::interactive_script();
     // For headless checks (scripts/check-report.sh): the number of figures the browser decoded.
     html += "<script>window.addEventListener('load',function(){var n=0;for(const i of document.images)"
             "if(i.complete&&i.naturalWidth>0)n++;document.body.setAttribute('data-images-loaded',n);});</script>\n";

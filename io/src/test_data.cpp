@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <map>
 
+#include "dynid/io/mat_file.hpp"
 #include "dynid/io/modal_data_io.hpp"
 #include "dynid/mesh/error.hpp"
 #include "dynid/solvers/signal.hpp"
@@ -477,6 +478,15 @@ LvmFile parse_lvm(const std::string& bytes, const std::string& path) {
 
 TestData read_test_data(const std::string& path, double sample_rate_hz, TableKind kind) {
   std::string ext = lower(std::filesystem::path(path).extension().string());
+  if (ext == ".mat") {  // a MATLAB recording: data (channels x samples), fs, channels (dynid/io/mat_file.hpp)
+    MatRecordingNames names;
+    names.file = path;
+    names.sample_rate_hz = sample_rate_hz;
+    TestData d;
+    d.kind = TestData::Kind::kTimeHistory;
+    d.recording = read_mat_recording(names);
+    return d;
+  }
   if (ext != ".uff" && ext != ".unv" && ext != ".lvm" && ext != ".txt" && ext != ".csv" && ext != ".dat" && ext != ".tsv") {
     // By content: the first non-blank line.
     const std::string head = internal::read_file_bytes(path).substr(0, 4096);

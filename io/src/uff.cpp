@@ -1,6 +1,8 @@
 // Universal File Format reader and writer (see dynid/io/uff.hpp for the formats).
 #include "dynid/io/uff.hpp"
 
+#include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cstdarg>
 #include <cmath>
@@ -9,6 +11,7 @@
 #include <cstring>
 #include <limits>
 #include <map>
+#include <set>
 #include <tuple>
 
 #include "dynid/io/output.hpp"
@@ -528,6 +531,351 @@ UffUnits read164(const Ctx& c, const Block& b) {
   return u;
 }
 
+// ---- 2414, 18, 2420 (vendor FE results and coordinate systems) ---------------------------------------------------
+
+/// Numbers from the lines of a block starting at line k until `count` are read; returns the next line index.
+std::size_t read_values(const Ctx& c, const Block& b, std::size_t k, std::size_t count, int record, const std::string& who,
+                        std::vector<double>* out) {
+  std::vector<double> v;
+  std::size_t got = 0;
+  const int first = k < b.line_no.size() ? b.line_no[k] : b.last_line;
+  while (got < count && k < b.lines.size()) {
+    if (!record_numbers(b.lines[k], {13}, &v))
+      c.fail(record_name(record), b.line_no[k], who + ": not a number in '" + std::string(rtrim(b.lines[k])) + "'");
+    got += v.size();
+    out->insert(out->end(), v.begin(), v.end());
+    ++k;
+  }
+  if (got != count)
+    c.fail(record_name(record), first, who + ": expected " + std::to_string(count) + " values, found " + std::to_string(got) +
+                                           (b.closed ? "" : " (file truncated?)"));
+  return k;
+}
+
+Uff2414 read2414(const Ctx& c, const Block& b, std::vector<std::string>* notes) {
+  if (b.lines.size() < 13)
+    c.fail(record_name(static_cast<int>(b.lines.size()) + 1), b.last_line,
+           "the header has " + std::to_string(b.lines.size()) + " of its 13 records (file truncated?)");
+  Uff2414 d;
+  const auto r1 = int_record(c, b.lines[0], b.line_no[0], 1, {10}, 1, "analysis dataset label");
+  d.label = r1[0];
+  d.name = std::string(rtrim(b.lines[1]));
+  d.location = int_record(c, b.lines[2], b.line_no[2], 3, {10}, 1, "dataset location")[0];
+  for (int k = 0; k < 5; ++k) d.id[k] = std::string(rtrim(b.lines[3 + k]));
+  const auto r9 = int_record(c, b.lines[8], b.line_no[8], 9, {10}, 6,
+                             "model type, analysis type, data characteristic, result type, data type, values per node");
+  d.model_type = r9[0];
+  d.analysis_type = r9[1];
+  d.data_characteristic = r9[2];
+  d.result_type = r9[3];
+  d.data_type = r9[4];
+  d.values_per_node = r9[5];
+  if (d.data_type != 1 && d.data_type != 2 && d.data_type != 4 && d.data_type != 5 && d.data_type != 6)
+    c.fail(record_name(9), b.line_no[8], "data type (field 5) must be 1, 2, 4, 5 or 6, found " + std::to_string(d.data_type));
+  if (d.values_per_node < 1 || d.values_per_node > 9)
+    c.fail(record_name(9), b.line_no[8], "values per data component (field 6) must be 1..9, found " + std::to_string(d.values_per_node));
+  d.integers = int_record(c, b.lines[9], b.line_no[9], 10, {10}, 1, "integer analysis data 1-8");
+  const auto r11 = int_record(c, b.lines[10], b.line_no[10], 11, {10}, 1, "integer analysis data 9-10");
+  d.integers.resize(8, 0);
+  d.integers.insert(d.integers.end(), r11.begin(), r11.end());
+  d.integers.resize(10, 0);
+  std::vector<double> r12, r13;
+  if (!record_numbers(b.lines[11], {13}, &r12) || r12.empty())
+    c.fail(record_name(12), b.line_no[11], "expected real values (6E13.5), found '" + std::string(rtrim(b.lines[11])) + "'");
+  if (!record_numbers(b.lines[12], {13}, &r13) || r13.empty())
+    c.fail(record_name(13), b.line_no[12], "expected real values (6E13.5), found '" + std::string(rtrim(b.lines[12])) + "'");
+  r12.resize(6, 0.0);
+  r13.resize(6, 0.0);
+  d.reals = r12;
+  d.reals.insert(d.reals.end(), r13.begin(), r13.end());
+  if (d.location != 1) {
+    require_closed(c, b, record_name(14));
+    notes->push_back(c.file + ": dataset 2414 starting at line " + std::to_string(c.first_line) + ": data " +
+                     (d.location == 2 ? "on elements" : d.location == 3 ? "at nodes on elements" : "at points") +
+                     " (location " + std::to_string(d.location) + ") kept without values; dynid reads data at nodes");
+    return d;
+  }
+  const std::size_t per_node = static_cast<std::size_t>(d.values_per_node) * (d.complex() ? 2 : 1);
+  std::vector<double> vals;
+  std::size_t k = 13;
+  while (k < b.lines.size()) {
+    if (trim(b.lines[k]).empty()) {
+      ++k;
+      continue;
+    }
+    int node = 0;
+    if (!parse_int(b.lines[k], &node))
+      c.fail(record_name(14), b.line_no[k], "expected a node number (I10), found '" + std::string(rtrim(b.lines[k])) + "'");
+    ++k;
+    k = read_values(c, b, k, per_node, 15, "node " + std::to_string(node), &vals);
+    d.nodes.push_back(node);
+  }
+  require_closed(c, b, record_name(15));
+  const auto nn = static_cast<Eigen::Index>(d.nodes.size());
+  d.values.resize(nn, d.values_per_node);
+  for (Eigen::Index i = 0; i < nn; ++i)
+    for (int j = 0; j < d.values_per_node; ++j) {
+      const std::size_t at = static_cast<std::size_t>(i) * per_node + static_cast<std::size_t>(d.complex() ? 2 * j : j);
+      d.values(i, j) = std::complex<double>(vals[at], d.complex() ? vals[at + 1] : 0.0);
+    }
+  return d;
+}
+
+UffCoordinateSystems read18(const Ctx& c, const Block& b) {
+  UffCoordinateSystems d;
+  std::size_t k = 0;
+  std::vector<double> v, w;
+  while (k < b.lines.size()) {
+    if (trim(b.lines[k]).empty()) {
+      ++k;
+      continue;
+    }
+    if (k + 3 >= b.lines.size())
+      c.fail(record_name(static_cast<int>(b.lines.size() - k) + 1), b.last_line,
+             "coordinate system " + std::to_string(d.systems.size() + 1) + ": expected 4 records (file truncated?)");
+    const auto r1 = int_record(c, b.lines[k], b.line_no[k], 1, {10}, 3, "number, type, reference system, colour, method");
+    UffCoordinateSystem s;
+    s.id = r1[0];
+    s.type = r1[1];
+    s.reference = r1[2];
+    if (s.type < 0 || s.type > 2) c.fail(record_name(1), b.line_no[k], "coordinate system type must be 0, 1 or 2, found " + std::to_string(s.type));
+    if (r1.size() > 4 && r1[4] != 1)
+      c.fail(record_name(1), b.line_no[k], "method of definition " + std::to_string(r1[4]) + " is not 1 (origin, +x axis, +xz plane)");
+    s.name = std::string(trim(b.lines[k + 1]));
+    if (!record_numbers(b.lines[k + 2], {13}, &v) || v.size() != 6)
+      c.fail(record_name(3), b.line_no[k + 2], "expected the origin and a point on +x (6E13.5), found '" + std::string(rtrim(b.lines[k + 2])) + "'");
+    if (!record_numbers(b.lines[k + 3], {13}, &w) || w.size() != 3)
+      c.fail(record_name(4), b.line_no[k + 3], "expected a point in the +xz plane (3E13.5), found '" + std::string(rtrim(b.lines[k + 3])) + "'");
+    s.definition = {Eigen::Vector3d(v[0], v[1], v[2]), Eigen::Vector3d(v[3], v[4], v[5]), Eigen::Vector3d(w[0], w[1], w[2])};
+    d.systems.push_back(s);
+    k += 4;
+  }
+  require_closed(c, b, record_name(4));
+  return d;
+}
+
+UffCoordinateSystems read2420(const Ctx& c, const Block& b) {
+  if (b.lines.size() < 2) c.fail(record_name(static_cast<int>(b.lines.size()) + 1), b.last_line, "the part header is incomplete (file truncated?)");
+  UffCoordinateSystems d;
+  d.part_uid = int_record(c, b.lines[0], b.line_no[0], 1, {10}, 1, "part UID")[0];
+  d.part_name = std::string(trim(b.lines[1]));
+  std::size_t k = 2;
+  std::vector<double> v;
+  while (k < b.lines.size()) {
+    if (trim(b.lines[k]).empty()) {
+      ++k;
+      continue;
+    }
+    if (k + 5 >= b.lines.size())
+      c.fail(record_name(3 + static_cast<int>(b.lines.size() - k)), b.last_line,
+             "coordinate system " + std::to_string(d.systems.size() + 1) + ": expected 6 records (file truncated?)");
+    const auto r3 = int_record(c, b.lines[k], b.line_no[k], 3, {10}, 2, "label, type, colour");
+    UffCoordinateSystem s;
+    s.id = r3[0];
+    s.type = r3[1];
+    if (s.type < 0 || s.type > 2) c.fail(record_name(3), b.line_no[k], "coordinate system type must be 0, 1 or 2, found " + std::to_string(s.type));
+    s.name = std::string(trim(b.lines[k + 1]));
+    Eigen::Matrix<double, 4, 3> T;
+    for (int r = 0; r < 4; ++r) {
+      if (!record_numbers(b.lines[k + 2 + r], {25}, &v) || v.size() != 3)
+        c.fail(record_name(5 + r), b.line_no[k + 2 + r], "expected row " + std::to_string(r + 1) +
+                                                             " of the transformation matrix (3D25.16), found '" + std::string(rtrim(b.lines[k + 2 + r])) + "'");
+      T.row(r) << v[0], v[1], v[2];
+    }
+    const Eigen::Matrix3d A = T.topRows<3>().transpose();  // columns: the local axes
+    if (!A.allFinite() || (A.transpose() * A - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 || A.determinant() < 0)
+      c.fail(record_name(5), b.line_no[k + 2], "coordinate system " + std::to_string(s.id) +
+                                                   ": rows 1-3 of its transformation matrix are not a right-handed set of unit axes");
+    s.axes = A;
+    s.origin = T.row(3).transpose();
+    s.resolved = true;
+    d.systems.push_back(s);
+    k += 6;
+  }
+  require_closed(c, b, record_name(8));
+  return d;
+}
+
+constexpr double kDegree = 0.017453292519943295769236907684886;
+
+}  // namespace
+
+Eigen::Vector3d UffCoordinateSystem::to_global(const Eigen::Vector3d& p) const {
+  Eigen::Vector3d local = p;
+  if (type == 1) {
+    const double t = p[1] * kDegree;
+    local = Eigen::Vector3d(p[0] * std::cos(t), p[0] * std::sin(t), p[2]);
+  } else if (type == 2) {
+    const double t = p[1] * kDegree, f = p[2] * kDegree;
+    local = Eigen::Vector3d(p[0] * std::sin(t) * std::cos(f), p[0] * std::sin(t) * std::sin(f), p[0] * std::cos(t));
+  }
+  return origin + axes * local;
+}
+
+Eigen::Matrix3d UffCoordinateSystem::directions_at(const Eigen::Vector3d& g) const {
+  if (type == 0) return axes;
+  const Eigen::Vector3d q = axes.transpose() * (g - origin);  // the point in the local Cartesian frame
+  Eigen::Matrix3d local;
+  const double phi = std::atan2(q[1], q[0]);
+  if (type == 1) {
+    local << std::cos(phi), -std::sin(phi), 0, std::sin(phi), std::cos(phi), 0, 0, 0, 1;
+  } else {
+    const double theta = std::atan2(std::hypot(q[0], q[1]), q[2]);
+    const Eigen::Vector3d er(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+    const Eigen::Vector3d et(std::cos(theta) * std::cos(phi), std::cos(theta) * std::sin(phi), -std::sin(theta));
+    const Eigen::Vector3d ef(-std::sin(phi), std::cos(phi), 0);
+    local.col(0) = er;
+    local.col(1) = et;
+    local.col(2) = ef;
+  }
+  return axes * local;
+}
+
+double Uff2414::frequency_hz() const {
+  if ((analysis_type == 3 || analysis_type == 7) && reals.size() >= 8)
+    return std::abs(std::complex<double>(reals[6], reals[7])) / kTwoPi;
+  return reals.size() > 1 ? reals[1] : 0.0;
+}
+
+double Uff2414::damping_ratio() const {
+  if ((analysis_type == 3 || analysis_type == 7) && reals.size() >= 8) {
+    const double mag = std::abs(std::complex<double>(reals[6], reals[7]));
+    return mag > 0 ? -reals[6] / mag : 0.0;
+  }
+  return analysis_type == 2 && reals.size() > 4 ? reals[4] : 0.0;
+}
+
+namespace {
+
+// Every coordinate system of a file by id, resolved to global axes (18's definitions chain through their
+// reference systems). Systems that cannot be resolved (a missing or circular reference) stay unresolved, with
+// a note.
+std::map<int, UffCoordinateSystem> coordinate_systems(UffFile* f) {
+  std::map<int, UffCoordinateSystem> cs;
+  for (UffDataset& ds : f->datasets)
+    if (auto* d = std::get_if<UffCoordinateSystems>(&ds.data))
+      for (const UffCoordinateSystem& s : d->systems) cs[s.id] = s;
+  for (int pass = 0; pass < static_cast<int>(cs.size()) + 1; ++pass) {
+    bool changed = false;
+    for (auto& [id, s] : cs) {
+      if (s.resolved) continue;
+      const UffCoordinateSystem* ref = nullptr;
+      UffCoordinateSystem global;
+      global.resolved = true;
+      if (s.reference == 0) ref = &global;
+      else if (auto it = cs.find(s.reference); it != cs.end() && it->second.resolved) ref = &it->second;
+      if (!ref) continue;
+      const Eigen::Vector3d o = ref->to_global(s.definition[0]), px = ref->to_global(s.definition[1]),
+                            pxz = ref->to_global(s.definition[2]);
+      const Eigen::Vector3d x = px - o, v = pxz - o;
+      const Eigen::Vector3d zdir = v - (v.dot(x) / std::max(x.squaredNorm(), 1e-300)) * x;
+      if (!(x.norm() > 0) || !(zdir.norm() > 1e-12 * x.norm())) {
+        f->notes.push_back(f->source + ": coordinate system " + std::to_string(id) +
+                           ": its origin, +x point and +xz point do not span a plane; it is not applied");
+        s.reference = id;  // never resolvable
+        continue;
+      }
+      s.axes.col(0) = x.normalized();
+      s.axes.col(2) = zdir.normalized();
+      s.axes.col(1) = s.axes.col(2).cross(s.axes.col(0));
+      s.origin = o;
+      s.resolved = true;
+      changed = true;
+    }
+    if (!changed) break;
+  }
+  for (const auto& [id, s] : cs)
+    if (!s.resolved && s.reference != id)
+      f->notes.push_back(f->source + ": coordinate system " + std::to_string(id) + " refers to system " + std::to_string(s.reference) +
+                         ", which the file does not define (or which refers back to it); it is not applied");
+  // Store the resolved systems back into the datasets (for readers of the datasets).
+  for (UffDataset& ds : f->datasets)
+    if (auto* d = std::get_if<UffCoordinateSystems>(&ds.data))
+      for (UffCoordinateSystem& s : d->systems) s = cs[s.id];
+  return cs;
+}
+
+// Turns the nodal vectors of `values` (nodes x 3 or 6: translations, then rotations) at nodes with a local
+// displacement system into global directions. Returns the number of nodes turned; `missing` collects systems
+// that are not defined.
+int rotate_to_global(const std::vector<int>& nodes, Eigen::MatrixXcd* values, const std::map<int, UffNode>& node_of,
+                     const std::map<int, UffCoordinateSystem>& cs, std::set<int>* missing) {
+  int turned = 0;
+  const Eigen::Index per = values->cols();
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    auto n = node_of.find(nodes[i]);
+    if (n == node_of.end() || n->second.displacement_cs == 0) continue;
+    auto s = cs.find(n->second.displacement_cs);
+    if (s == cs.end() || !s->second.resolved) {
+      missing->insert(n->second.displacement_cs);
+      continue;
+    }
+    const Eigen::Matrix3d R = s->second.directions_at(n->second.x);
+    const auto row = static_cast<Eigen::Index>(i);
+    for (Eigen::Index block = 0; block + 3 <= per; block += 3) {
+      const Eigen::Vector3cd v = values->block(row, block, 1, 3).transpose();
+      values->block(row, block, 1, 3) = (R.cast<std::complex<double>>() * v).transpose();
+    }
+    ++turned;
+  }
+  return turned;
+}
+
+// Converts local node coordinates to global and local vectors of 55/2414 to global directions, using the
+// coordinate systems and nodes of `geo` (the file itself, or its geometry file).
+void apply_coordinate_systems(UffFile* f, UffFile* geo) {
+  const std::map<int, UffCoordinateSystem> cs = coordinate_systems(geo);
+  if (geo == f) {
+    int converted = 0;
+    std::set<int> missing;
+    for (UffDataset& ds : f->datasets)
+      if (auto* d = std::get_if<UffNodes>(&ds.data))
+        for (UffNode& n : d->nodes) {
+          n.x_file = n.x;
+          if (n.definition_cs == 0) continue;
+          auto s = cs.find(n.definition_cs);
+          if (s == cs.end() || !s->second.resolved) {
+            n.global = false;
+            missing.insert(n.definition_cs);
+            continue;
+          }
+          n.x = s->second.to_global(n.x_file);
+          ++converted;
+        }
+    if (converted > 0)
+      f->notes.push_back(f->source + ": " + std::to_string(converted) + " node coordinates converted from local coordinate systems to global");
+    for (int id : missing)
+      f->notes.push_back(f->source + ": nodes are defined in coordinate system " + std::to_string(id) +
+                         ", which the file does not define (dataset 18 or 2420): their coordinates are as written, not global");
+  }
+  std::map<int, UffNode> node_of;
+  for (const UffDataset& ds : geo->datasets)
+    if (const auto* d = std::get_if<UffNodes>(&ds.data))
+      for (const UffNode& n : d->nodes) node_of[n.id] = n;
+  bool any_local = false;
+  for (const auto& [id, n] : node_of) any_local = any_local || n.displacement_cs != 0;
+  if (!any_local) return;
+  int turned = 0;
+  std::set<int> missing;
+  for (UffDataset& ds : f->datasets) {
+    if (auto* d = std::get_if<Uff55>(&ds.data); d && !d->in_global && (d->values_per_node == 3 || d->values_per_node == 6)) {
+      turned += rotate_to_global(d->nodes, &d->values, node_of, cs, &missing);
+      d->in_global = true;
+    }
+    if (auto* d = std::get_if<Uff2414>(&ds.data);
+        d && !d->in_global && d->location == 1 && (d->values_per_node == 3 || d->values_per_node == 6)) {
+      turned += rotate_to_global(d->nodes, &d->values, node_of, cs, &missing);
+      d->in_global = true;
+    }
+  }
+  if (turned > 0)
+    f->notes.push_back(f->source + ": nodal vectors at " + std::to_string(turned) +
+                       " nodes turned from their local displacement coordinate systems to global directions");
+  for (int id : missing)
+    f->notes.push_back(f->source + ": nodal vectors refer to displacement coordinate system " + std::to_string(id) +
+                       ", which is not defined: they are left in it");
+}
+
 }  // namespace
 
 // ---- reading --------------------------------------------------------------------------------------------------
@@ -568,6 +916,9 @@ UffFile parse_uff(const std::string& bytes, const std::string& name) {
         case 2411: ds.data = read2411(c, b); break;
         case 2412: ds.data = read2412(c, b, &f.notes); break;
         case 164: ds.data = read164(c, b); break;
+        case 2414: ds.data = read2414(c, b, &f.notes); break;
+        case 18: ds.data = read18(c, b); break;
+        case 2420: ds.data = read2420(c, b); break;
         default:
           if (!b.closed) c.fail("", b.last_line, "the file ends without the closing -1 line (truncated?)");
           ds.data = UffSkipped{};
@@ -576,7 +927,18 @@ UffFile parse_uff(const std::string& bytes, const std::string& name) {
     f.datasets.push_back(std::move(ds));
   }
   if (f.datasets.empty()) throw InputError(name + ": no UFF datasets (the file is empty or blank)");
+  // Vectors are in global directions unless a node's displacement system says otherwise (applied below).
+  for (UffDataset& ds : f.datasets) {
+    if (auto* d = std::get_if<Uff55>(&ds.data)) d->in_global = false;
+    if (auto* d = std::get_if<Uff2414>(&ds.data)) d->in_global = false;
+  }
+  apply_coordinate_systems(&f, &f);
   return f;
+}
+
+void uff_apply_coordinate_systems(UffFile* data, const UffFile& geometry) {
+  UffFile geo = geometry;
+  apply_coordinate_systems(data, &geo);
 }
 
 UffFile read_uff(const std::string& path) { return parse_uff(internal::read_file_bytes(path), path); }
@@ -1033,15 +1395,31 @@ FrfData uff_frf(const std::vector<const UffFile*>& files) {
 }
 
 ModalData uff_modal_data(const UffFile& f) {
-  std::vector<const Uff55*> modes;
-  for (const UffDataset& ds : f.datasets)
+  // One view per mode: 55 (analysis type 2, 3, 7) and 2414 (data at nodes, analysis type 2, 3, 7, three- or six-DOF
+  // vectors).
+  struct ModeView {
+    const std::vector<int>* nodes;
+    const Eigen::MatrixXcd* values;
+    int values_per_node;
+    bool complex;
+    double frequency_hz, damping;
+  };
+  std::vector<ModeView> modes;
+  for (const UffDataset& ds : f.datasets) {
     if (const auto* p = std::get_if<Uff55>(&ds.data))
-      if (p->analysis_type == 2 || p->analysis_type == 3 || p->analysis_type == 7) modes.push_back(p);
-  if (modes.empty()) throw InputError(f.source + ": no modes (dataset 55 with analysis type 2, 3 or 7)");
+      if (p->analysis_type == 2 || p->analysis_type == 3 || p->analysis_type == 7)
+        modes.push_back({&p->nodes, &p->values, p->values_per_node, p->complex, p->frequency_hz(), p->damping_ratio()});
+    if (const auto* q = std::get_if<Uff2414>(&ds.data))
+      if ((q->analysis_type == 2 || q->analysis_type == 3 || q->analysis_type == 7) && q->location == 1 &&
+          (q->data_characteristic == 2 || q->data_characteristic == 3) && q->values.cols() >= 3)
+        modes.push_back({&q->nodes, &q->values, static_cast<int>(q->values.cols()), q->complex(), q->frequency_hz(), q->damping_ratio()});
+  }
+  if (modes.empty())
+    throw InputError(f.source + ": no modes (dataset 55, or 2414 with data at nodes, analysis type 2, 3 or 7)");
   std::vector<int> nodes;
   std::map<int, int> row_of;
-  for (const Uff55* m : modes)
-    for (int n : m->nodes)
+  for (const ModeView& m : modes)
+    for (int n : *m.nodes)
       if (row_of.emplace(n, static_cast<int>(nodes.size())).second) nodes.push_back(n);
   const auto nm = static_cast<Eigen::Index>(modes.size());
   Eigen::MatrixXd all = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nodes.size()) * kNumDofTypes, nm);
@@ -1050,18 +1428,19 @@ ModalData uff_modal_data(const UffFile& f) {
   out.frequencies_hz.resize(nm);
   out.damping_ratios.resize(nm);
   for (Eigen::Index k = 0; k < nm; ++k) {
-    const Uff55& m = *modes[static_cast<std::size_t>(k)];
+    const ModeView& m = modes[static_cast<std::size_t>(k)];
+    const Eigen::MatrixXcd& values = *m.values;
     std::complex<double> rot = 1.0;
-    if (m.complex && m.values.size() > 0) {
+    if (m.complex && values.size() > 0) {
       Eigen::Index i, j;
-      m.values.cwiseAbs().maxCoeff(&i, &j);
-      if (std::abs(m.values(i, j)) > 0) rot = std::conj(m.values(i, j)) / std::abs(m.values(i, j));
+      values.cwiseAbs().maxCoeff(&i, &j);
+      if (std::abs(values(i, j)) > 0) rot = std::conj(values(i, j)) / std::abs(values(i, j));
     }
-    for (std::size_t n = 0; n < m.nodes.size(); ++n)
+    for (std::size_t n = 0; n < m.nodes->size(); ++n)
       for (int j = 0; j < std::min(m.values_per_node, kNumDofTypes); ++j)
-        all(row_of[m.nodes[n]] * kNumDofTypes + j, k) = (rot * m.values(static_cast<Eigen::Index>(n), j)).real();
-    out.frequencies_hz[k] = m.frequency_hz();
-    out.damping_ratios[k] = m.damping_ratio();
+        all(row_of[(*m.nodes)[n]] * kNumDofTypes + j, k) = (rot * values(static_cast<Eigen::Index>(n), j)).real();
+    out.frequencies_hz[k] = m.frequency_hz;
+    out.damping_ratios[k] = m.damping;
   }
   std::vector<Eigen::Index> keep;
   for (Eigen::Index r = 0; r < all.rows(); ++r)

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "dynid/engine/modal_data.hpp"
+#include "dynid/io/mat_file.hpp"
 #include "dynid/io/point_map.hpp"
 #include "internal/yaml_util.hpp"
 
@@ -18,6 +19,10 @@ std::string resolve(const std::string& dir, const std::string& file);
 /// The `geometry:` of a section (`detect`, `update`, `discover`): FILE | {file: FILE, match: position | id,
 /// tolerance: T}, only beside measured:. None given: an empty GeometrySpec.
 GeometrySpec parse_geometry(const YAML::Node& section, const std::string& name, const YamlCtx& ctx, const std::string& dir);
+/// The `measured:` file of a section: FILE, or {mat: FILE, frequency_hz | eigenvalues: VAR, shapes: VAR, dofs: VAR,
+/// damping: VAR} (a MATLAB file, whose variable names parse_measured_mat() returns).
+std::string parse_measured(const YAML::Node& n, const YamlCtx& ctx, const std::string& dir, const std::string& what);
+MatModalNames parse_measured_mat(const YAML::Node& section, const std::string& name, const YamlCtx& ctx);
 
 }  // namespace dynid::internal
 

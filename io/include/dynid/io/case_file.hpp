@@ -14,6 +14,7 @@
 #include "dynid/engine/identify.hpp"
 #include "dynid/engine/virtual_test.hpp"
 #include "dynid/engine/model_fit.hpp"
+#include "dynid/io/mat_file.hpp"
 #include "dynid/io/point_map.hpp"
 #include "dynid/engine/parametric.hpp"
 #include "dynid/mesh/model.hpp"
@@ -35,7 +36,8 @@ struct AnalysisSpec {
 /// element changes, its exact modes taken at `measured_dofs`) or measured modal data from a file.
 struct DetectSpec {
   std::vector<std::pair<int, std::pair<double, double>>> changes;  ///< element id -> (dk, dm)
-  std::string measured_file;            ///< changed-state modal data (JSON) instead of `changes`
+  std::string measured_file;            ///< changed-state modal data (JSON, UFF, .mat) instead of `changes`
+  MatModalNames measured_mat;           ///< a .mat measured file's variables
   std::string reference_measured_file;  ///< optional reference-state modal data
   GeometrySpec geometry;                ///< test geometry tying the measured files' points to model nodes
   std::vector<MeasuredDof> measured_dofs;  ///< DOFs the simulated changed state is "measured" at
@@ -48,6 +50,7 @@ struct DetectSpec {
 /// simulated target: the model with element factors changed, sampled at `measured_dofs`).
 struct UpdateSpec {
   std::string measured_file;
+  MatModalNames measured_mat;            ///< a .mat measured file's variables
   GeometrySpec geometry;  ///< test geometry tying the measured file's points to model nodes
   std::vector<std::pair<int, PropertyFactors>> target_changes;  ///< simulated target
   std::vector<MeasuredDof> measured_dofs;
@@ -75,9 +78,11 @@ struct TestSpec {
 /// identify first, or - for concealed-data studies - a virtual test of a `truth` model the analysis never sees),
 /// the discovery options, and optionally what the answer should be (`expect`, for the test suite).
 struct DiscoverSpec {
-  std::string measured_file;               ///< UFF 55 or modal-data JSON
+  std::string measured_file;               ///< UFF 55/2414, modal-data JSON or .mat
+  MatModalNames measured_mat;              ///< a .mat measured file's variables
   GeometrySpec geometry;                   ///< test geometry tying the measured file's points to model nodes
-  std::vector<std::string> recordings;     ///< UFF 58 / text recordings, identified first
+  std::vector<std::string> recordings;     ///< UFF 58 / text / .mat recordings, identified first
+  std::vector<MatRecordingNames> recording_mat;  ///< per recording: a .mat file's variables (file "" = default names)
   std::string method;                      ///< identification method for recordings ("" = by the data)
   IdentificationOptions identify;
   std::shared_ptr<Model> truth;            ///< concealed-data study: the truth model
@@ -118,11 +123,20 @@ Case load_case(const std::string& path);
 /// Parses a case from text (for tests and host codes); `name` is used in messages as the file name.
 Case parse_case(const std::string& text, const std::string& name, const std::string& dir = ".");
 
+/// A case whose model is built in memory (by a host code, or from Python): `text` (YAML or JSON) holds the
+/// other sections (name, description, analysis, detect, update, test, discover; no model:), parsed against
+/// `model` (finalized) with every check and message of a case file; `name` names the text in messages and
+/// relative paths in it resolve against `dir`.
+Case case_with_model(Model model, const std::string& text, const std::string& name, const std::string& dir = ".");
+
 /// The changed state of a detect: case: measured data from its file, or the exact modes of the changed model at
 /// the measured DOFs (then *changed, unless null, receives that model, for DetectOptions::simulated_changed).
 ModalData detect_changed_data(const Case& c, Model* changed);
 /// The measured data of an update: case: from its file, or the simulated target; the first `modes` modes.
 ModalData update_measured_data(const Case& c);
+/// The first `count` modes of `m` (all when count <= 0), with every per-mode value (damping, MPC, standard
+/// deviations) cut alike.
+ModalData first_modes(ModalData m, int count);
 
 /// The virtual test `t` describes, run on `model`: its modes up to t.max_frequency_hz (default 1.2 x Nyquist) with
 /// the solver settings `eo`, then simulate_test with the noise seed shifted by `seed_offset`. Throws

@@ -17,6 +17,8 @@ namespace dynid {
 ///             "order_frequency_std_hz", "same_shape_as" (twins)}],
 ///  "rejected": [{"frequency_hz", "damping_ratio", "poles", "support", "reason" ("few orders", "complex shape",
 ///               "indicator trough", "split"), "value", "limit", "merged_into" (split: mode number)}],
+///  "stabilization": {"poles": [[order, frequency_hz, damping_ratio, class, mode]], "frequency_hz", "background",
+///                    "background_label"},
 ///  "notes": [...]}; the modes array reads back with read_modal_data.
 nlohmann::ordered_json identification_json(const IdentificationSummary& s);
 

@@ -13,7 +13,8 @@ struct ReaderLimits {
   double max_generated_elements = 1e7;   ///< elements one case-file `generate:` block builds
   long long max_generated_ids = 10000000;  ///< ids one Abaqus *NSET / *ELSET GENERATE line makes
   long long max_matrix_dimension = 100000000;  ///< rows or columns of a Matrix Market matrix
-  int max_element_dofs = 2000;  ///< DOFs of one element, group or remainder of a matrix model (stored dense)
+  int max_element_dofs = 2000;
+  long long max_mat_elements = 2000000000;  ///< elements of one variable of a .mat file  ///< DOFs of one element, group or remainder of a matrix model (stored dense)
 };
 
 /// The process-wide limits (mutable: a host program or a fuzz target may lower or raise them).

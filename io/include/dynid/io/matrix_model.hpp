@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "dynid/mesh/model.hpp"
+#include "dynid/solvers/sparse.hpp"
 
 namespace dynid {
 
@@ -50,6 +51,31 @@ struct ElementMatrices {
 /// Parses an element-matrices file held in memory; `name` names it in messages ("file:line: ...").
 /// `num_equations` bounds the equation numbers (rows of the DOF table).
 std::vector<ElementMatrices> parse_element_matrices(const std::string& text, const std::string& name, int num_equations);
+
+/// A matrix model held in memory: what the files of MatrixModelFiles hold once read, and what a MATLAB file
+/// (dynid/io/mat_file.hpp) or a Python host gives. Names in the `*_name` fields say where each part came from
+/// in messages ("dofs.csv", "bridge.mat: variable K0").
+struct MatrixModelData {
+  std::vector<DofRow> dofs;     ///< equation i -> (node, DOF type)  (required)
+  std::string dofs_name = "the DOF table";
+  std::vector<Node> nodes;      ///< every node a DOF names (required)
+  std::string nodes_name = "the node table";
+  std::vector<ElementMatrices> elements;  ///< element matrices on 0-based equations
+  struct Group {
+    std::string name;           ///< the group (element group name)
+    std::string K_name, M_name; ///< where K and M came from
+    SparseMatrix K, M;          ///< on the global equations; M (or K) 0 x 0 = none (zero)
+  };
+  std::vector<Group> groups;    ///< one Matrix element each, on the equations it touches
+  bool has_assembled = false;   ///< K and M below are given (checked against the sum of the elements)
+  SparseMatrix K, M;
+  std::string K_name = "K", M_name = "M";
+};
+
+/// Adds the nodes and Matrix elements of an in-memory matrix model to `model` (not finalized), as
+/// add_matrix_model(files) does: groups become dense elements on the equations they touch (at most
+/// ReaderLimits::max_element_dofs), and what K and M hold beyond the elements becomes a "remainder" element.
+void add_matrix_model(const MatrixModelData& data, Model* model, std::vector<std::string>* notes = nullptr);
 
 /// Adds the nodes and Matrix elements of a matrix model to `model` (not finalized: the caller may add supports,
 /// springs, point masses, then finalize). Remarks (e.g. a remainder element) go to `notes` if not null. Throws

@@ -22,5 +22,7 @@ void refuse_existing(const std::vector<std::string>& paths, bool overwrite);
 /// The modal results as JSON: {"case", "dofs", "nonzeros", "modes": [{"index", "frequency_hz", "eigenvalue",
 /// "rigid_body", "description"?, "residual"}], "solver": {...}}. See docs/results-json.md.
 nlohmann::json modal_json(const Case& c, const ModalResult& r);
+/// The same for a model without a case file; `name` goes to "case".
+nlohmann::json modal_json(const std::string& name, const ModalResult& r);
 
 }  // namespace dynid

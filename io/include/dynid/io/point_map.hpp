@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "dynid/engine/modal_data.hpp"
+#include "dynid/io/mat_file.hpp"
 #include "dynid/io/uff.hpp"
 #include "dynid/mesh/model.hpp"
 
@@ -33,8 +34,9 @@ std::map<int, int> map_test_points(const Model& model, const UffFile& geometry, 
 /// is not in `map` (naming it and `source`).
 void relabel_points(const std::map<int, int>& map, const std::string& source, ModalData* d);
 
-/// Measured modal data from a .json or UFF 55 file; with a geometry file, relabelled to model nodes.
+/// Measured modal data from a .json, UFF 55/2414 or .mat file (the variables `mat` names; UFF shape directions
+/// turned to global by the geometry file's coordinate systems); with a geometry file, relabelled to model nodes.
 ModalData read_measured_modal_data(const std::string& file, const GeometrySpec& geometry, const Model& model,
-                                   std::vector<std::string>* notes = nullptr);
+                                   std::vector<std::string>* notes = nullptr, const MatModalNames& mat = MatModalNames());
 
 }  // namespace dynid

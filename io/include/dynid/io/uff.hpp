@@ -48,7 +48,31 @@
 //        The connectivity is kept as it is.
 //   164  units: I10,20A1,I10 (code, description, temperature mode), 3D25.17 (length, force, temperature
 //        factors), D25.17 (temperature offset).
-// Other datasets (151, 18, 82, ...) are skipped; they are listed with their type and line.
+//   2414 analysis data (FE results: the mode shapes NX, Simcenter, I-DEAS and Permas export): record 1 label (I10),
+//        2 name (40A2), 3 dataset location (I10: 1 data at nodes, 2 on elements, 3 at nodes on elements, 5 at
+//        points), 4-8 ID lines, 9 (6I10) model type, analysis type (1 static, 2 normal mode, 3 complex
+//        eigenvalue first order, 4 transient, 5 frequency response, 6 buckling, 7 complex eigenvalue second
+//        order), data characteristic (1 scalar, 2 three-DOF vector, 3 six-DOF vector, 4 symmetric tensor),
+//        result type (8 displacement, 11 velocity, 12 acceleration, ...), data type (1 integer, 2 single,
+//        4 double, 5 single complex, 6 double complex), values per node (NVALDC); 10-11 (8I10, 2I10) integers:
+//        design set, iteration, solution set, boundary condition, load set, mode number, time step, frequency
+//        number, creation option, number retained; 12-13 (6E13.5 each) reals: time, frequency [Hz], eigenvalue,
+//        modal mass, viscous damping ratio, hysteretic damping ratio, eigenvalue re/im, modal A re/im, modal B
+//        re/im; then for data at nodes, per node record 14 (node, I10) and record 15 (its NVALDC values, real or
+//        re/im pairs, on as many lines as they take). Other locations are kept without values (a note says so).
+//   18   coordinate systems: per system record 1 (5I10: number, type 0 Cartesian / 1 cylindrical / 2 spherical,
+//        reference system, colour, method of definition 1), record 2 name (20A2), record 3 (6E13.5: origin and a
+//        point on the +x axis) and record 4 (3E13.5: a point in the +xz plane), all in the reference system.
+//   2420 coordinate systems: record 1 part UID, record 2 part name, then per system record 3 (3I10: label, type,
+//        colour), record 4 name, records 5-8 (3D25.16 each): rows 1-3 the local x, y, z axes as unit vectors in
+//        global coordinates, row 4 the origin.
+// Coordinate systems are applied after reading: points of 15/2411 defined in a local system (definition
+// coordinate system != 0) are converted to global coordinates (cylindrical: r, theta [deg] about local z, z;
+// spherical: r, theta [deg] from local z, phi [deg] about local z from local x), and the nodal vectors of 55
+// and 2414 at nodes whose displacement coordinate system is local are turned into global directions (the
+// system's axes at the node: radial, tangential, axial for cylindrical systems). A point or vector whose
+// system the file does not define keeps its values, and a note says so (UffNode::global is false).
+// Other datasets (151, 82, ...) are skipped; they are listed with their type and line.
 //
 // Writing: dynid writes 58 in ASCII (values with 17 significant digits, 3 per line, so doubles read back exactly;
 // this is wider than the standard E20.12, so only readers that split on blanks read it) or binary 58b (little
@@ -111,6 +135,7 @@ struct Uff55 {
   Eigen::MatrixXcd values;     ///< nodes x values_per_node
 
   int mode_number() const { return record7.size() > 3 ? record7[3] : 0; }
+  bool in_global = true;       ///< vectors are in global directions (see the header comment)
   /// Natural frequency [Hz]: record 8 field 1 for normal modes and frequency response, |eigenvalue| / 2 pi for
   /// complex modes.
   double frequency_hz() const;
@@ -119,10 +144,58 @@ struct Uff55 {
   double damping_ratio() const;
 };
 
+/// Dataset 2414: analysis data (FE results). Data at nodes (location 1) are kept; other locations only their
+/// header.
+struct Uff2414 {
+  int label = 1;
+  std::string name = "NONE";
+  int location = 1;            ///< 1 data at nodes, 2 on elements, 3 at nodes on elements, 5 at points
+  std::array<std::string, 5> id{{"NONE", "NONE", "NONE", "NONE", "NONE"}};
+  int model_type = 1, analysis_type = 2, data_characteristic = 2, result_type = 8, data_type = 2;
+  int values_per_node = 3;     ///< NVALDC
+  std::vector<int> integers = std::vector<int>(10, 0);    ///< records 10-11
+  std::vector<double> reals = std::vector<double>(12, 0.0);  ///< records 12-13
+  std::vector<int> nodes;
+  Eigen::MatrixXcd values;     ///< nodes x values_per_node (data at nodes)
+  bool in_global = true;       ///< vectors are in global directions (see the header comment)
+
+  bool complex() const { return data_type == 5 || data_type == 6; }
+  int mode_number() const { return integers.size() > 5 ? integers[5] : 0; }
+  /// Hz: record 12 field 2 for normal modes and frequency response; |eigenvalue| / 2 pi (record 13 fields 1-2)
+  /// for complex modes.
+  double frequency_hz() const;
+  /// Viscous damping ratio (record 12 field 5) of normal modes; -Re(eigenvalue)/|eigenvalue| of complex modes.
+  double damping_ratio() const;
+};
+
+/// Datasets 18 and 2420: coordinate systems, resolved to global axes and origin after reading.
+struct UffCoordinateSystem {
+  int id = 0;
+  int type = 0;                ///< 0 Cartesian, 1 cylindrical, 2 spherical
+  int reference = 0;           ///< 18: the system the definition points are given in
+  std::string name;
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();  ///< columns: local x, y, z unit vectors (global)
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();    ///< global
+  std::array<Eigen::Vector3d, 3> definition{};         ///< 18: origin, +x point, +xz point (reference system)
+  bool resolved = false;       ///< axes and origin are known in global coordinates
+  /// Global coordinates of a point given in this system (r, theta, z / r, theta, phi for curvilinear ones).
+  Eigen::Vector3d to_global(const Eigen::Vector3d& p) const;
+  /// The system's unit directions at a point (global coordinates), as columns: x, y, z for Cartesian systems;
+  /// radial, tangential, axial for cylindrical; radial, theta, phi for spherical.
+  Eigen::Matrix3d directions_at(const Eigen::Vector3d& global_point) const;
+};
+struct UffCoordinateSystems {
+  int part_uid = 0;            ///< 2420
+  std::string part_name;       ///< 2420
+  std::vector<UffCoordinateSystem> systems;
+};
+
 /// Dataset 15 or 2411: nodes.
 struct UffNode {
   int id = 0, definition_cs = 0, displacement_cs = 0, colour = 0;
-  Eigen::Vector3d x = Eigen::Vector3d::Zero();
+  Eigen::Vector3d x = Eigen::Vector3d::Zero();  ///< global coordinates (converted from the definition system)
+  Eigen::Vector3d x_file = Eigen::Vector3d::Zero();  ///< the coordinates as written, in the definition system
+  bool global = true;  ///< false: the definition system is not in the file; x holds the coordinates as written
 };
 struct UffNodes {
   std::vector<UffNode> nodes;
@@ -149,9 +222,9 @@ struct UffUnits {
 struct UffSkipped {};
 
 struct UffDataset {
-  int type = 0;                ///< 58 (also for 58b), 55, 15, 2411, 2412, 164, or the skipped type
+  int type = 0;                ///< 58 (also for 58b), 55, 15, 2411, 2412, 164, 2414, 18, 2420, or the skipped type
   int first_line = 0;          ///< line of the opening "-1" (1-based)
-  std::variant<UffSkipped, Uff58, Uff55, UffNodes, UffElements, UffUnits> data;
+  std::variant<UffSkipped, Uff58, Uff55, UffNodes, UffElements, UffUnits, Uff2414, UffCoordinateSystems> data;
 };
 
 struct UffFile {
@@ -197,8 +270,15 @@ Recording uff_recording(const UffFile& f);
 FrfData uff_frf(const UffFile& f);
 /// The same over several files (one FRF per file, one file per reference, ...): their FRFs together.
 FrfData uff_frf(const std::vector<const UffFile*>& files);
+/// Applies the coordinate systems of `geometry` (its 18/2420 systems and its 15/2411 nodes' displacement systems)
+/// to the 55 and 2414 vectors of `data` that are not yet in global directions (data files without their own
+/// geometry). Notes go to data->notes. parse_uff() does this with the file's own datasets.
+void uff_apply_coordinate_systems(UffFile* data, const UffFile& geometry);
+
 /// The modes (55, analysis type 2, 3 or 7) of a file. Complex shapes are rotated to their largest component and
 /// the real part is kept. DOFs that are exactly zero in every mode are left out (UFF 55 has no "not measured").
+/// FE mode shapes of dataset 2414 (data at nodes, analysis type 2, 3 or 7, three- or six-DOF vectors) count as
+/// modes too.
 ModalData uff_modal_data(const UffFile& f);
 
 /// 58 datasets for a Recording (one per record and channel; ASCII or binary) / an FrfData (one per output/input

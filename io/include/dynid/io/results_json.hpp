@@ -1,0 +1,48 @@
+// dynid/io/results_json.hpp -- what `dynid detect` and `dynid update` compute for a case, and their results JSON
+// (docs/results-json.md). One home for each, so that the command line and the Python module (python/) give the
+// same numbers in the same structure.
+#pragma once
+
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "dynid/engine/detect.hpp"
+#include "dynid/engine/model_fit.hpp"
+#include "dynid/engine/parametric.hpp"
+#include "dynid/io/case_file.hpp"
+#include "dynid/io/discover_io.hpp"
+
+namespace dynid {
+
+/// `dynid detect` on a case: the changed state (simulated from detect: changes, or read from measured:), the
+/// reference-state data when the case names one, then detect(). Throws InputError when the case has no detect:.
+DetectSummary detect_case(const Case& c);
+
+/// The detect results JSON: {"case", "method", "threshold_rule", "full_dofs", "modes", "localization",
+/// "quantification", "first_order_condition", "serep", "warnings"}.
+nlohmann::json detect_json(const std::string& case_name, const DetectSummary& s);
+
+/// `dynid update` on a case: the measured data, the parametric model of the case's parameters, the fit.
+/// `pm` refers to c.model: keep the case alive while the run is used.
+struct UpdateRun {
+  ModalData measured;
+  std::unique_ptr<ParametricModel> pm;
+  FitSummary fit;
+};
+UpdateRun update_case(const Case& c);
+
+/// The update results JSON: {"case", "parameters", "frequencies_hz", "mac", "objective", "iterations",
+/// "model_evaluations", "cost", "termination", "converged", "covariance", "warnings"}. `u` gives the initial
+/// values, which parameters are free, the ties and the objective.
+nlohmann::json update_json(const std::string& case_name, const ParametricModel& pm, const UpdateSpec& u,
+                           const FitSummary& f);
+
+/// The measured modes of a discover: case given in memory instead of the case's measured: / recordings: (host
+/// codes, Python): modal data, kept as discovery_data() keeps a file's (min_mpc, modes), or recordings,
+/// identified as the case's recordings are (its identify: options; without a band, the band the model implies
+/// for the sensors). `source` names the data in the results.
+DiscoveryData discovery_data(const Case& c, ModalData measured, const std::string& source);
+DiscoveryData discovery_data(const Case& c, std::vector<Recording> recordings, const std::string& source);
+
+}  // namespace dynid

@@ -1,0 +1,111 @@
+// What `dynid detect` and `dynid update` compute for a case, and their results JSON (dynid/io/results_json.hpp).
+#include "dynid/io/results_json.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "dynid/io/point_map.hpp"
+
+namespace dynid {
+
+namespace {
+std::vector<double> vec(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+nlohmann::json num(double v) { return std::isnan(v) ? nlohmann::json() : nlohmann::json(v); }
+}  // namespace
+
+DetectSummary detect_case(const Case& c) {
+  require_section(c, c.detect.has_value(), "detect");
+  const DetectSpec& d = *c.detect;
+  Model changed_m;
+  DetectOptions opt = d.options;
+  const ModalData changed = detect_changed_data(c, &changed_m);
+  if (!d.changes.empty()) opt.simulated_changed = &changed_m;
+  ModalData refmeas;
+  if (!d.reference_measured_file.empty()) refmeas = read_measured_modal_data(d.reference_measured_file, d.geometry, c.model);
+  return detect(c.model, changed, opt, d.reference_measured_file.empty() ? nullptr : &refmeas);
+}
+
+nlohmann::json detect_json(const std::string& case_name, const DetectSummary& S) {
+  nlohmann::json j;
+  j["case"] = case_name;
+  j["method"] = S.method;
+  j["threshold_rule"] = S.threshold_rule;
+  j["full_dofs"] = S.full_dofs;
+  j["modes"] = {{"used", S.used_modes}, {"model_hz", vec(S.model_hz)}, {"changed_hz", vec(S.changed_hz)}, {"mac", vec(S.mac)}};
+  nlohmann::json els = nlohmann::json::array();
+  for (const ElementScore& e : S.elements)
+    els.push_back({{"id", e.element},
+                   {"score", e.probability},
+                   {"flagged", e.flagged},
+                   {"rank", e.rank},
+                   {"pseudo", num(e.pseudo)},
+                   {"pseudo_rank", e.pseudo_rank},
+                   {"chi2", e.chi2},
+                   {"twins", e.twins}});
+  nlohmann::json dofs = nlohmann::json::array();
+  for (std::size_t r = 0; r < S.dofs.size(); ++r)
+    dofs.push_back({{"dof", to_string(S.dofs[r])}, {"pseudo", S.pseudo[r]}, {"reference", S.pseudo_reference[r]},
+                    {"delta", S.delta_pseudo[r]}});
+  j["localization"] = {{"elements", els},
+                       {"dofs", dofs},
+                       {"score", S.full_dofs ? "fraction of the residual-force energy the element alone explains"
+                                             : "posterior probability that this element alone changed"},
+                       {"chi2_unchanged", S.chi2_unchanged},
+                       {"chi2_final", S.chi2_final}};
+  nlohmann::json q = nlohmann::json::array();
+  for (const ElementAmount& a : S.amounts)
+    q.push_back({{"element", a.element}, {"dk", a.dk}, {"dm", a.dm}, {"dk_first_order", a.dk_first_order},
+                 {"dm_first_order", a.dm_first_order}, {"dk_std", num(a.dk_std)}, {"dm_std", num(a.dm_std)}});
+  j["quantification"] = q;
+  j["first_order_condition"] = S.first_order_condition;
+  j["serep"] = {{"modes", S.serep_modes}, {"rank", S.serep_rank}};
+  j["localization"]["confidence_set"] = S.confidence_set;
+  j["warnings"] = S.warnings;
+  return j;
+}
+
+UpdateRun update_case(const Case& c) {
+  require_section(c, c.update.has_value(), "update");
+  const UpdateSpec& u = *c.update;
+  UpdateRun run;
+  run.measured = update_measured_data(c);
+  run.pm = std::make_unique<ParametricModel>(c.model);
+  for (const Parameter& p : u.parameters) run.pm->add(p);
+  run.fit = fit_parameters(*run.pm, run.measured, u.initial, u.free, u.options);
+  return run;
+}
+
+nlohmann::json update_json(const std::string& case_name, const ParametricModel& pm, const UpdateSpec& u, const FitSummary& f) {
+  nlohmann::json params = nlohmann::json::array();
+  for (int p = 0; p < pm.num_parameters(); ++p) {
+    const Parameter& q = pm.parameter(p);
+    std::string status = u.free.empty() || u.free[p] ? "free" : "fixed";
+    for (const auto& t : u.ties)
+      if (t.first == p) status = "tied to " + pm.parameter(t.second.first).name;
+    params.push_back({{"name", q.name},
+                      {"kind", std::string(parameter_kind_name(q.kind))},
+                      {"initial", u.initial[p]},
+                      {"value", f.theta[p]},
+                      {"std", num(f.stddev[p])},
+                      {"std_aposteriori", num(f.stddev[p] * f.residual_scale)},
+                      {"status", status},
+                      {"at_bound", std::find(f.at_bound.begin(), f.at_bound.end(), p) != f.at_bound.end()}});
+  }
+  nlohmann::json j;
+  j["case"] = case_name;
+  j["parameters"] = params;
+  j["frequencies_hz"] = {{"initial", vec(f.initial_hz)}, {"updated", vec(f.final_hz)}, {"measured", vec(f.measured_hz)}};
+  j["mac"] = {{"initial", vec(f.initial_mac)}, {"updated", vec(f.final_mac)}};
+  j["objective"] = std::string(fit_objective_name(u.options.objective));
+  j["iterations"] = f.iterations;
+  j["model_evaluations"] = f.evaluations;
+  j["cost"] = {{"initial", f.initial_cost}, {"final", f.final_cost}, {"history", f.cost_history}};
+  j["termination"] = f.termination;
+  j["converged"] = f.converged;
+  j["covariance"] = {{"rank", f.covariance_rank}, {"free_parameters", f.free_parameters}, {"full_rank", f.covariance_ok},
+                     {"residual_scale", num(f.residual_scale)}};
+  j["warnings"] = f.warnings;
+  return j;
+}
+
+}  // namespace dynid
