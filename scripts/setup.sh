@@ -17,6 +17,9 @@ packages=(
   clang libclang-rt-14-dev libomp-dev  # scripts/sanitize.sh, fuzz.sh: clang, libFuzzer, sanitizer run-times, OpenMP
   python3 python3-numpy python3-scipy python3-slepc4py python3-petsc4py
   python3-matplotlib  # bench/discovery: the concealed-physics benchmark's figures
+  python3-dev pybind11-dev python3-pytest python3-h5py  # the Python package (python/, docs/python.md) and its tests
+  libmatio-dev zlib1g-dev  # .mat files (v5 and v7.3); the report's compressed plotly.js
+  libjs-three python3-plotly  # the report's 3D mode shapes (three.js) and zoomable plots (plotly.js), embedded
 )
 
 missing=()
