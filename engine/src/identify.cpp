@@ -262,10 +262,15 @@ IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationO
     if (frf.frequency_hz[k] > 0 && frf.frequency_hz[k] >= lo && frf.frequency_hz[k] <= hi) lines.push_back(k);
   const Eigen::Index nf = static_cast<Eigen::Index>(lines.size());
   const int ni = frf.num_inputs(), no = frf.num_outputs();
-  const int pmax = o.max_order > 0 ? o.max_order : std::max(10, 60 / ni);
+  // Orders not given: up to 60 / inputs, but no more than the band's lines support (a narrow band of a short
+  // record); orders given are kept or refused.
+  int pmax = o.max_order > 0 ? o.max_order : std::max(10, 60 / ni);
   const int pmin = o.min_order > 0 ? o.min_order : 2;
+  if (o.max_order == 0) pmax = std::min(pmax, static_cast<int>(nf / 2) - 1);
   const int step = o.order_step > 0 ? o.order_step : 1;
-  if (nf < 2 * (pmax + 1)) throw InputError("LSCF: " + std::to_string(nf) + " frequency lines in the band are too few for order " + std::to_string(pmax));
+  if (nf < 2 * (pmax + 1) || pmax < std::max(pmin + 2, 6))
+    throw InputError("LSCF: " + std::to_string(nf) + " frequency lines in the band are too few for order " + std::to_string(std::max(pmax, 6)) +
+                     ": widen the band or use longer records (finer frequency lines)");
 
   IdentificationSummary s;
   s.method = "lscf";

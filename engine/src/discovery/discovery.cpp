@@ -46,6 +46,7 @@ bool DiscoveryOptions::IsValid(std::string* why) const {
   if (max_effects < 1) return fail("max_effects must be >= 1");
   if (!(decisive > 0) || !(ambiguity >= 0)) return fail("decisive must be > 0 and ambiguity >= 0");
   if (!(further > 0 && further <= 1) || !(partial >= 0 && partial <= 1)) return fail("further must be in (0, 1], partial in [0, 1]");
+  if (!(min_share >= 0 && min_share < 1) || !(model_form >= 0 && model_form < 1)) return fail("min_share and model_form must be in [0, 1)");
   if (!(min_significance >= 0)) return fail("min_significance must be >= 0");
   if (max_iterations < 1) return fail("max_iterations must be >= 1");
   if (!(min_mac > 0 && min_mac < 1)) return fail("min_mac must be in (0, 1)");
@@ -186,7 +187,7 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
     return f.ok && span > 0 ? std::clamp((chi2_0 - f.chi2) / span, 0.0, 1.0) : 0.0;
   };
   auto score = [&](const SetFit& f, std::size_t k) {
-    ScoredHypothesis h = scored(p, f, k);
+    ScoredHypothesis h = scored(p, f, k, sel.scale);
     h.log_evidence = log_evidence(p, f, chi2_0, sel.scale);
     h.explained = relative(f);
     h.significance = significance(f, k, sel.scale);

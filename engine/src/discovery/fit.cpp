@@ -91,6 +91,7 @@ SetFit fit_set(const Problem& p, const std::vector<const Candidate*>& set, const
   if (!std::isfinite(s.final_cost)) return out;
   out.chi2 = 2.0 * s.final_cost;
   out.residuals = s.final_residuals;
+  out.chi2_frequency = s.final_chi2_frequency;
   out.information = s.information;
   out.quality = quality_of(p, s.final_hz, s.final_mac, out.chi2, s.final_forced);
   for (std::size_t k = 0; k < set.size(); ++k) {
@@ -201,7 +202,7 @@ double significance(const SetFit& f, std::size_t k, double scale) {
   return std::isfinite(sd) && sd > 0 ? std::abs(th - q.nominal) / sd : 0.0;
 }
 
-ScoredHypothesis scored(const Problem& p, const SetFit& f, std::size_t k) {
+ScoredHypothesis scored(const Problem& p, const SetFit& f, std::size_t k, double scale) {
   const Candidate& c = *f.set[k];
   ScoredHypothesis h;
   h.kind = c.kind();
@@ -213,7 +214,16 @@ ScoredHypothesis scored(const Problem& p, const SetFit& f, std::size_t k) {
   h.fitted = f.ok;
   if (!f.ok) return h;
   h.chi2 = f.chi2;
-  h.values = c.physical(f.theta[k], f.stddev[k]);
+  // Reported standard deviations: the statistical one at the larger of the evidence's noise scale and the
+  // frequencies' own (a candidate that approximates the real physics misfits the frequencies far more than the
+  // shapes, and the values rest on the frequencies), with the candidate's model-form uncertainty, `model_form`
+  // of its change from nominal, in quadrature.
+  const double sf = std::sqrt(std::max(1.0, f.chi2_frequency / std::max(1, p.modes - f.parameters())));
+  const std::vector<CandidateParameter> ps = c.parameters();
+  Eigen::VectorXd sd = f.stddev[k] * std::max(scale, sf);
+  for (Eigen::Index q = 0; q < sd.size(); ++q)
+    sd[q] = std::hypot(sd[q], p.options.model_form * std::abs(f.theta[k][q] - ps[static_cast<std::size_t>(q)].nominal));
+  h.values = c.physical(f.theta[k], sd);
   if (!p.options.si_units)
     for (PhysicalValue& v : h.values)
       if (!v.unit.empty() && v.unit != "%") v.unit = "(model units)";

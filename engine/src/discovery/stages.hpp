@@ -68,10 +68,11 @@ struct SetFit {
   std::vector<const Candidate*> set;
   std::vector<Eigen::VectorXd> theta, stddev;  ///< per candidate, its own parameters
   double chi2 = 0;                 ///< whitened residual sum of squares at the solution
+  double chi2_frequency = 0;       ///< its frequency part
   Eigen::VectorXd residuals;       ///< the whitened residuals at the solution (what the set predicts, less the data)
   Eigen::MatrixXd information;     ///< J^T J over the set's parameters (whitened at the stated noise)
   FitQuality quality;
-  /// Sum over the unpartnered modes this set pairs of (edge chi-square - its chi-square): evidence from modes the
+  /// Sum over the unpartnered modes this set pairs of (log-density gain, prepare.cpp): evidence from modes the
   /// model as given lacks.
   double unpartnered_gain = 0;
   bool at_bound = false;           ///< a magnitude (first) parameter ended on a bound
@@ -115,7 +116,8 @@ FitQuality quality_of(const Problem& p, const Eigen::VectorXd& model_hz, const E
 double log_evidence(const Problem& p, const SetFit& f, double chi2_0, double scale);
 /// Smallest |theta - nominal| / std over the set's parameters of candidate k (std scaled by `scale`); 0 on a bound.
 double significance(const SetFit& f, std::size_t k, double scale);
-ScoredHypothesis scored(const Problem& p, const SetFit& f, std::size_t k);
+/// One candidate of a fitted set as reported: its values with standard deviations scaled by `scale`.
+ScoredHypothesis scored(const Problem& p, const SetFit& f, std::size_t k, double scale);
 /// Whether two candidates tell the same story: the same global kind, or local ones of compatible nature (mass
 /// with mass, stiffness with stiffness; "both" with either) at sites that share a node.
 bool same_story(const Model& m, const Candidate& a, const Candidate& b);

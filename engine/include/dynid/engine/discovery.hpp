@@ -60,6 +60,10 @@ struct DiscoveryOptions {
   /// proportion to the effect it models, which a second candidate will always reduce; a real second effect
   /// carries a share of its own.
   double min_share = 0.01;
+  /// Model-form uncertainty of a finding's values: a candidate approximates the real physics (a spring for a soft
+  /// stub, a point mass for a block), so its reported standard deviation has this share of its change from
+  /// nominal added in quadrature (docs/method.md).
+  double model_form = 0.05;
   /// A further effect's parameters must differ from nominal by this many standard deviations.
   double min_significance = 3.0;
   int max_iterations = 100;        ///< Ceres iterations per fit
