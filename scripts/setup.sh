@@ -49,3 +49,12 @@ esac
 jobs=$(nproc 2>/dev/null || echo 2)
 cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release ${DYNID_CMAKE_ARGS:-} >/dev/null
 cmake --build "$build" -j "$jobs"
+# The Python package into Debian's python3 (/usr/local/lib/python3.X/dist-packages/dynid): `import dynid` works
+# without PYTHONPATH (docs/python.md). Skipped without root or sudo; PYTHONPATH=build/python works then.
+if [ "$(id -u)" = 0 ]; then
+  cmake --install "$build" --component python >/dev/null
+elif command -v sudo >/dev/null && sudo -n true 2>/dev/null; then
+  sudo cmake --install "$build" --component python >/dev/null
+else
+  echo "dynid setup: the Python package stays in $build/python (no root): use PYTHONPATH=$build/python" >&2
+fi

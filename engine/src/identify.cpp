@@ -24,12 +24,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 using Clock = std::chrono::steady_clock;
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 // Marks modes whose shape repeats a stronger one's nearby (split pairs / duplicates).
 void mark_twins(std::vector<IdentifiedMode>& modes, bool by_contribution) {
   for (std::size_t a = 0; a < modes.size(); ++a)
