@@ -47,6 +47,7 @@ bool DiscoveryOptions::IsValid(std::string* why) const {
   if (!(decisive > 0) || !(ambiguity >= 0)) return fail("decisive must be > 0 and ambiguity >= 0");
   if (!(further > 0 && further <= 1) || !(partial >= 0 && partial <= 1)) return fail("further must be in (0, 1], partial in [0, 1]");
   if (!(min_share >= 0 && min_share < 1) || !(model_form >= 0 && model_form < 1)) return fail("min_share and model_form must be in [0, 1)");
+  if (!(min_data_frequency_noise >= 0) || !(min_data_shape_noise >= 0)) return fail("the noise floors must be >= 0");
   if (!(min_significance >= 0)) return fail("min_significance must be >= 0");
   if (max_iterations < 1) return fail("max_iterations must be >= 1");
   if (!(min_mac > 0 && min_mac < 1)) return fail("min_mac must be in (0, 1)");
