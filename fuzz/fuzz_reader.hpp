@@ -21,6 +21,7 @@ inline void lower_limits() {
   limits.max_generated_ids = 100000;
   limits.max_matrix_dimension = 100000;
   limits.max_element_dofs = 200;
+  limits.max_mat_elements = 1000000;
 }
 
 template <class Reader>

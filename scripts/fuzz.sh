@@ -28,10 +28,17 @@ for t in "${targets[@]}"; do
   mkdir -p "$build/corpus/$t"
   dict=()
   [ -f "$here/fuzz/$t.dict" ] && dict=("-dict=$here/fuzz/$t.dict")
+  # fuzz/<target>.options (optional, sourced): extra libFuzzer flags and ASan options of one target, each stated
+  # with its reason there.
+  flags=()
+  asan_extra=""
+  # shellcheck disable=SC1090
+  [ -f "$here/fuzz/$t.options" ] && source "$here/fuzz/$t.options"
   log="$build/$t.log"
   rc=0
+  ASAN_OPTIONS="$ASAN_OPTIONS${asan_extra:+:$asan_extra}" \
   "$build/fuzz/$t" -max_total_time="$seconds" -runs="$runs" -timeout=10 -rss_limit_mb=2048 -max_len=16384 \
-    -print_final_stats=1 -artifact_prefix="$build/artifacts/$t-" "${dict[@]}" \
+    -print_final_stats=1 -artifact_prefix="$build/artifacts/$t-" "${dict[@]}" "${flags[@]}" \
     "$build/corpus/$t" "$here/fuzz/corpus/$t" >"$log" 2>&1 || rc=$?
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   if [ "$rc" = 0 ]; then

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <new>
 #include <mutex>
 
 #include "dynid/io/limits.hpp"
@@ -133,6 +134,17 @@ struct MatFile::Handle {
     if (numel(info.get()) < 0)
       fail(path, name, "a " + dims_text(info.get()) + " array is larger than dynid reads (" +
                            limit_text(static_cast<double>(reader_limits().max_mat_elements)) + " elements)");
+    // A damaged header can declare far more data than the file holds, and libmatio allocates what it declares
+    // before reading (fuzz_mat found a 4 GB request from a 1 kB file). Data never exceeds the file by more than
+    // zlib's largest ratio (about 1032:1); sparse arrays hold fewer values than their dimensions.
+    if (info->class_type != MAT_C_SPARSE) {
+      std::error_code ec;
+      const double file_bytes = static_cast<double>(std::filesystem::file_size(path, ec));
+      const double bytes = static_cast<double>(numel(info.get())) * static_cast<double>(Mat_SizeOfClass(info->class_type));
+      if (!ec && bytes > 1100.0 * file_bytes + 1e6)
+        fail(path, name, "declares a " + dims_text(info.get()) + " array (" + limit_text(bytes) + " bytes) in a file of " +
+                             limit_text(file_bytes) + " bytes: the file is damaged; save it again from MATLAB or SciPy");
+    }
     info.reset();
     Mat_Rewind(mat);
     Var v(Mat_VarRead(mat, name.c_str()));
@@ -206,7 +218,12 @@ Eigen::MatrixXd dense_of(const matvar_t* v, const std::string& who) {
   if (v->rank > 2) throw InputError(who + " is a " + dims_text(v) + " array; a matrix (2-D) is needed");
   const auto rows = static_cast<Eigen::Index>(v->rank >= 1 ? v->dims[0] : 0);
   const auto cols = static_cast<Eigen::Index>(v->rank >= 2 ? v->dims[1] : 1);
-  Eigen::MatrixXd A(rows, cols);
+  Eigen::MatrixXd A;
+  try {
+    A.resize(rows, cols);
+  } catch (const std::bad_alloc&) {
+    throw InputError(who + " is a " + dims_text(v) + " matrix; held dense it does not fit in memory");
+  }
   if (v->class_type == MAT_C_SPARSE) {
     A.setZero();
     const auto* s = static_cast<const mat_sparse_t*>(v->data);
