@@ -66,13 +66,6 @@ Opt plan(const Model& m, Opt::Excitation e, double fs, double duration, double b
 }
 constexpr double kFreqTol = 0.005, kDampTol = 0.2, kMinMac = 0.99;
 
-IdentificationOptions band(double lo, double hi) {
-  IdentificationOptions io;
-  io.band_lo_hz = lo;
-  io.band_hi_hz = hi;
-  return io;
-}
-
 TEST(VirtualTest, BeamImpactRoundTrip) {
   const Case c = load_case(test::CasesDir() + "/paper-beam");
   Opt o = plan(c.model, Opt::Excitation::kImpact, 2048, 4, 800);
@@ -81,7 +74,7 @@ TEST(VirtualTest, BeamImpactRoundTrip) {
   const VirtualTest t = simulate_test(c.model, all_modes(c.model), o);
   FrfOptions fo;
   fo.max_frequency_hz = 800;
-  const IdentificationOptions io = band(20, 700);
+  const IdentificationOptions io = test::Band(20, 700);
   expect_identified(t.modes, identify_lscf(estimate_frf(t.recordings, fo), io), 20, 700, kFreqTol, kDampTol, kMinMac);
   // An exponential window ending at 1 % adds 1.15 1/s of decay (40 % of the 45 Hz mode's own 2.86 1/s);
   // identification must take it off again: damping back within the same 20 %.
@@ -103,19 +96,19 @@ TEST(VirtualTest, FrameImpactRoundTrip) {
   const VirtualTest t = simulate_test(c.model, all_modes(c.model), o);
   FrfOptions fo;
   fo.max_frequency_hz = 10;
-  expect_identified(t.modes, identify_lscf(estimate_frf(t.recordings, fo), band(0.3, 8)), 0.3, 8, kFreqTol, kDampTol, kMinMac);
+  expect_identified(t.modes, identify_lscf(estimate_frf(t.recordings, fo), test::Band(0.3, 8)), 0.3, 8, kFreqTol, kDampTol, kMinMac);
 }
 
 TEST(VirtualTest, BeamAmbientRoundTrip) {
   const Case c = load_case(test::CasesDir() + "/paper-beam");
   const VirtualTest t = simulate_test(c.model, all_modes(c.model), plan(c.model, Opt::Excitation::kAmbient, 2048, 120, 800));
-  expect_identified(t.modes, identify_ssi(t.recordings[0], band(20, 700)), 20, 700, kFreqTol, kDampTol, kMinMac);
+  expect_identified(t.modes, identify_ssi(t.recordings[0], test::Band(20, 700)), 20, 700, kFreqTol, kDampTol, kMinMac);
 }
 
 TEST(VirtualTest, FrameAmbientRoundTrip) {
   const Case c = load_case(test::CasesDir() + "/paper-frame");
   const VirtualTest t = simulate_test(c.model, all_modes(c.model), plan(c.model, Opt::Excitation::kAmbient, 25.6, 3600, 10));
-  expect_identified(t.modes, identify_ssi(t.recordings[0], band(0.3, 8)), 0.3, 8, kFreqTol, kDampTol, kMinMac);
+  expect_identified(t.modes, identify_ssi(t.recordings[0], test::Band(0.3, 8)), 0.3, 8, kFreqTol, kDampTol, kMinMac);
 }
 
 }  // namespace

@@ -47,13 +47,6 @@ Recording channel_of(const Recording& r, int ch) {
   return one;
 }
 
-IdentificationOptions band(double lo, double hi) {
-  IdentificationOptions io;
-  io.band_lo_hz = lo;
-  io.band_hi_hz = hi;
-  return io;
-}
-
 // The force channel in its own file, every response in its own file: one test, the force its input, and the
 // same modes as from the recording written whole. Tolerance: frequencies within 1e-6 relative (the files hold
 // the samples in binary double precision; only the channel order may differ).
@@ -81,8 +74,8 @@ TEST(TestLayout, ForceChannelInItsOwnFileMakesOneTest) {
   EXPECT_EQ(recs[0].output_channels().size(), r.output_channels().size());
   EXPECT_EQ(recs[0].records.size(), r.records.size());
 
-  const IdentificationSummary a = identify_recordings(recs, "", band(20, 700));
-  const IdentificationSummary b = identify_recordings(read_test_set({whole}).recordings(), "", band(20, 700));
+  const IdentificationSummary a = identify_recordings(recs, "", test::Band(20, 700));
+  const IdentificationSummary b = identify_recordings(read_test_set({whole}).recordings(), "", test::Band(20, 700));
   ASSERT_GE(a.modes.size(), 3u);
   ASSERT_EQ(a.modes.size(), b.modes.size());
   for (std::size_t k = 0; k < a.modes.size(); ++k) EXPECT_TRUE(test::RelClose(a.modes[k].frequency_hz, b.modes[k].frequency_hz, 1e-6));

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <string>
 
+#include "dynid/engine/identify.hpp"
 #include "dynid/mesh/error.hpp"
 #include "dynid/solvers/sparse.hpp"
 
@@ -15,6 +16,14 @@
 #define EXPECT_HAS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << "message: " << (text)
 
 namespace dynid::test {
+
+/// Identification options with only the band set (the rest at their defaults).
+inline IdentificationOptions Band(double lo, double hi) {
+  IdentificationOptions io;
+  io.band_lo_hz = lo;
+  io.band_hi_hz = hi;
+  return io;
+}
 
 /// |a - b| <= rtol * max(|a|, |b|) (or both exactly zero).
 inline ::testing::AssertionResult RelClose(double a, double b, double rtol) {

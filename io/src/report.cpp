@@ -30,26 +30,6 @@ std::string esc(const std::string& s) {
   return o;
 }
 
-std::string base64(const std::string& in) {
-  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string o;
-  o.reserve((in.size() + 2) / 3 * 4);
-  std::size_t i = 0;
-  for (; i + 2 < in.size(); i += 3) {
-    const unsigned v = (static_cast<unsigned char>(in[i]) << 16) | (static_cast<unsigned char>(in[i + 1]) << 8) |
-                       static_cast<unsigned char>(in[i + 2]);
-    o += t[v >> 18], o += t[(v >> 12) & 63], o += t[(v >> 6) & 63], o += t[v & 63];
-  }
-  if (i < in.size()) {
-    unsigned v = static_cast<unsigned char>(in[i]) << 16;
-    if (i + 1 < in.size()) v |= static_cast<unsigned char>(in[i + 1]) << 8;
-    o += t[v >> 18], o += t[(v >> 12) & 63];
-    o += i + 1 < in.size() ? t[(v >> 6) & 63] : '=';
-    o += '=';
-  }
-  return o;
-}
-
 json read_json(const fs::path& p) {
   const std::string text = internal::read_file_bytes(p.string());
   try {
@@ -276,7 +256,7 @@ std::string html_report(const std::string& dir) {
       const fs::path pp = step_file(d, manifest, st, "plot");
       if (!pp.empty() && fs::is_regular_file(pp, ec) && pp.extension() == ".png") {
         body += "<img alt=\"" + esc(step) + " figure\" src=\"data:image/png;base64," +
-                base64(internal::read_file_bytes(pp.string())) + "\">\n";
+                internal::base64(internal::read_file_bytes(pp.string())) + "\">\n";
         ++images;
       }
       body += "</section>\n";

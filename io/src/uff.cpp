@@ -348,6 +348,26 @@ Uff58 read58_binary(const Ctx& c, internal::LineReader& in, std::string_view typ
 
 // ---- 55 -------------------------------------------------------------------------------------------------------
 
+/// Numbers from the lines of a block starting at line k until `count` are read; returns the next line index. A
+/// short count is reported at `count_line` (default: the first line read).
+std::size_t read_values(const Ctx& c, const Block& b, std::size_t k, std::size_t count, int record, const std::string& who,
+                        std::vector<double>* out, int count_line = -1) {
+  std::vector<double> v;
+  std::size_t got = 0;
+  const int first = count_line >= 0 ? count_line : k < b.line_no.size() ? b.line_no[k] : b.last_line;
+  while (got < count && k < b.lines.size()) {
+    if (!record_numbers(b.lines[k], {13}, &v))
+      c.fail(record_name(record), b.line_no[k], who + ": not a number in '" + std::string(rtrim(b.lines[k])) + "'");
+    got += v.size();
+    out->insert(out->end(), v.begin(), v.end());
+    ++k;
+  }
+  if (got != count)
+    c.fail(record_name(record), first, who + ": expected " + std::to_string(count) + " values, found " + std::to_string(got) +
+                                           (b.closed ? "" : " (file truncated?)"));
+  return k;
+}
+
 Uff55 read55(const Ctx& c, const Block& b) {
   if (b.lines.size() < 8)
     c.fail(record_name(static_cast<int>(b.lines.size()) + 1), b.last_line,
@@ -372,7 +392,7 @@ Uff55 read55(const Ctx& c, const Block& b) {
     c.fail(record_name(8), b.line_no[7], "expected real values (6E13.5), found '" + std::string(rtrim(b.lines[7])) + "'");
   d.record8 = r8;
   const int per_node = d.values_per_node * (d.complex ? 2 : 1);
-  std::vector<double> vals, line_vals;
+  std::vector<double> vals;
   std::size_t k = 8;
   while (k < b.lines.size()) {
     if (trim(b.lines[k]).empty()) {
@@ -384,18 +404,7 @@ Uff55 read55(const Ctx& c, const Block& b) {
       c.fail(record_name(9), b.line_no[k], "expected a node number (I10), found '" + std::string(rtrim(b.lines[k])) + "'");
     const int node_line = b.line_no[k];
     ++k;
-    std::size_t got = 0;
-    while (got < static_cast<std::size_t>(per_node) && k < b.lines.size()) {
-      if (!record_numbers(b.lines[k], {13}, &line_vals))
-        c.fail(record_name(10), b.line_no[k], "node " + std::to_string(node) + ": not a number in '" +
-                                                  std::string(rtrim(b.lines[k])) + "'");
-      got += line_vals.size();
-      vals.insert(vals.end(), line_vals.begin(), line_vals.end());
-      ++k;
-    }
-    if (got != static_cast<std::size_t>(per_node))
-      c.fail(record_name(10), node_line, "node " + std::to_string(node) + ": expected " + std::to_string(per_node) +
-                                             " values, found " + std::to_string(got) + (b.closed ? "" : " (file truncated?)"));
+    k = read_values(c, b, k, static_cast<std::size_t>(per_node), 10, "node " + std::to_string(node), &vals, node_line);
     d.nodes.push_back(node);
   }
   if (!b.closed) c.fail(record_name(10), b.last_line, "the file ends without the closing -1 line (truncated?)");
@@ -532,25 +541,6 @@ UffUnits read164(const Ctx& c, const Block& b) {
 }
 
 // ---- 2414, 18, 2420 (vendor FE results and coordinate systems) ---------------------------------------------------
-
-/// Numbers from the lines of a block starting at line k until `count` are read; returns the next line index.
-std::size_t read_values(const Ctx& c, const Block& b, std::size_t k, std::size_t count, int record, const std::string& who,
-                        std::vector<double>* out) {
-  std::vector<double> v;
-  std::size_t got = 0;
-  const int first = k < b.line_no.size() ? b.line_no[k] : b.last_line;
-  while (got < count && k < b.lines.size()) {
-    if (!record_numbers(b.lines[k], {13}, &v))
-      c.fail(record_name(record), b.line_no[k], who + ": not a number in '" + std::string(rtrim(b.lines[k])) + "'");
-    got += v.size();
-    out->insert(out->end(), v.begin(), v.end());
-    ++k;
-  }
-  if (got != count)
-    c.fail(record_name(record), first, who + ": expected " + std::to_string(count) + " values, found " + std::to_string(got) +
-                                           (b.closed ? "" : " (file truncated?)"));
-  return k;
-}
 
 Uff2414 read2414(const Ctx& c, const Block& b, std::vector<std::string>* notes) {
   if (b.lines.size() < 13)

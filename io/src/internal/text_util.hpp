@@ -23,6 +23,9 @@ bool parse_double(std::string_view s, double* out);
 /// An integer (the whole field, blanks ignored), within int range.
 bool parse_int(std::string_view s, int* out);
 
+/// Base64 (RFC 4648, with padding) of arbitrary bytes: images and compressed scripts embedded in a report.
+std::string base64(const std::string& bytes);
+
 /// A number for messages and reports, `digits` significant digits ("%.*g": 0.0123, 1.5e+07).
 std::string format_number(double v, int digits = 4);
 
