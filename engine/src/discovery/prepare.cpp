@@ -196,16 +196,14 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
   // A mode no model mode pairs has, under the model, only a vague density: uniform over the plausible range of
   // its whitened residuals (frequency ratio within max_frequency_ratio, each shape entry within +-1 of the
   // largest). Pairing it with a residual vector r replaces that density by the noise's normal one: the gain in
-  // -2 ln L is sum over entries of 2 ln(width / sqrt(2 pi)) - |r|^2, bounded by the "edge" below. (A chi-square
-  // edge, as before, grew with the inverse square of the noise and let one set-aside mode outweigh every
-  // paired one.)
-  for (std::size_t k = 0; k < lone.size(); ++k) {
+  // -2 ln L is sum over entries of 2 ln(width / sqrt(2 pi)) - |r|^2, bounded by the "edge" below: logarithmic in
+  // the noise, so that one set-aside mode cannot outweigh the paired ones. The same for every unpartnered mode.
+  {
+    auto gain = [](double width) { return std::max(0.0, 2.0 * std::log(width / std::sqrt(2 * M_PI))); };
     const double r2 = o.max_frequency_ratio * o.max_frequency_ratio;
     const double wf = (r2 - 1.0 / r2) / (2 * p.noise.frequency);  // width of the frequency residual (eigenvalue-based)
     const double ws = 2.0 / p.noise.shape;                          // width of a shape entry's residual
-    const double per = [](double w) { return std::max(0.0, 2.0 * std::log(w / std::sqrt(2 * M_PI))); }(ws);
-    p.unpartnered_edge[static_cast<Eigen::Index>(k)] =
-        std::max(0.0, 2.0 * std::log(wf / std::sqrt(2 * M_PI))) + per * static_cast<double>(measured.dofs.size());
+    p.unpartnered_edge.setConstant(gain(wf) + gain(ws) * static_cast<double>(measured.dofs.size()));
   }
 
   p.context = make_context(model, p.data.num_modes() ? p.data : measured, o.sensor_nodes, o.suspension_nodes, o.gravity);
