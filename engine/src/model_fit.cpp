@@ -614,6 +614,9 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
         J(r0 + k, k) = std::sqrt(o.regularization) / pm.parameter(free[k]).scale;
       }
     out.information = J.topRows(rows).transpose() * J.topRows(rows);
+    out.information_frequency = Eigen::MatrixXd::Zero(nf, nf);
+    if (o.objective != FitObjective::kSerep)
+      for (const auto& Jk : ef.J) out.information_frequency += Jk.row(0).transpose() * Jk.row(0);
     // Full V: its columns beyond the numerical rank span the null space of J (directions the data do not see).
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeFullV);
     const Eigen::VectorXd& sv = svd.singularValues();

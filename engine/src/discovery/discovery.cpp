@@ -47,6 +47,8 @@ bool DiscoveryOptions::IsValid(std::string* why) const {
   if (!(decisive > 0) || !(ambiguity >= 0)) return fail("decisive must be > 0 and ambiguity >= 0");
   if (!(further > 0 && further <= 1) || !(partial >= 0 && partial <= 1)) return fail("further must be in (0, 1], partial in [0, 1]");
   if (!(min_share >= 0 && min_share < 1) || !(model_form >= 0 && model_form < 1)) return fail("min_share and model_form must be in [0, 1)");
+  if (!(form_error_frequency > 0 && form_error_frequency < 1) || !(form_error_shape > 0 && form_error_shape < 1))
+    return fail("form_error_frequency and form_error_shape must be in (0, 1)");
   if (!(min_data_frequency_noise >= 0) || !(min_data_shape_noise >= 0)) return fail("the noise floors must be >= 0");
   if (!(min_significance >= 0)) return fail("min_significance must be >= 0");
   if (max_iterations < 1) return fail("max_iterations must be >= 1");
@@ -143,6 +145,8 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   S.data = p.n;
   S.eigen_solves = 2;
   const double chi2_0 = sc.chi2;
+  p.chi2_0 = sc.chi2;
+  p.chi2_0_frequency = sc.chi2_frequency;
   S.chi2_frequency_before = sc.chi2_frequency / p.modes;
   S.chi2_shape_before = (chi2_0 - sc.chi2_frequency) / std::max(1, p.n - p.modes);
   std::vector<char> forced0(sc.paired.size());
@@ -182,16 +186,20 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
       if (f.ok && f.chi2 < sel.chi2_best) sel.chi2_best = f.chi2;
   }
   S.eigen_solves += sel.eigen_solves;
-  S.noise_scale = sel.scale;
+  {
+    const ErrorScale es = sel.fit.set.empty() ? error_scale(p, chi2_0, sc.chi2_frequency) : error_scale(p, sel.fit);
+    S.noise_scale_frequency = es.frequency;
+    S.noise_scale_shape = es.shape;
+  }
   auto relative = [&](const SetFit& f) {
     const double span = chi2_0 - sel.chi2_best;
     return f.ok && span > 0 ? std::clamp((chi2_0 - f.chi2) / span, 0.0, 1.0) : 0.0;
   };
   auto score = [&](const SetFit& f, std::size_t k) {
-    ScoredHypothesis h = scored(p, f, k, sel.scale);
-    h.log_evidence = log_evidence(p, f, chi2_0, sel.scale);
+    ScoredHypothesis h = scored(p, f, k);
+    h.log_evidence = log_evidence(p, f);
     h.explained = relative(f);
-    h.significance = significance(f, k, sel.scale);
+    h.significance = significance(p, f, k);
     return h;
   };
   for (std::size_t k = 0; k < list.size(); ++k) {
@@ -242,17 +250,17 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   // whitened predictions differ by less than the data resolve, 2 x ambiguity in chi-square at the evidence's
   // noise) with about the same evidence. The data cannot tell them apart (a spring anywhere along an axially
   // rigid floor beam): the finding names them all, its own site first.
-  const double s2 = sel.scale * sel.scale;
   std::map<const Candidate*, std::vector<const Candidate*>> equivalent;
   for (std::size_t k = 0; k < order.size(); ++k) {
     const Candidate* c = sel.fit.set[order[k]];
     const auto own = std::find_if(singles.begin(), singles.end(), [&](const SetFit& f) { return f.ok && f.set[0] == c; });
     if (own == singles.end()) continue;
-    const double le = log_evidence(p, *own, chi2_0, sel.scale);
+    const double le = log_evidence(p, *own);
+    const ErrorScale es = error_scale(p, *own);
     for (const SetFit& g : singles) {
       if (!g.ok || g.at_bound || g.set[0] == c || g.set[0]->kind() != c->kind()) continue;
-      if (log_evidence(p, g, chi2_0, sel.scale) < le - options.ambiguity) continue;
-      if ((g.residuals - own->residuals).squaredNorm() / s2 > 2 * options.ambiguity) continue;
+      if (log_evidence(p, g) < le - options.ambiguity) continue;
+      if (scaled_norm2(p, g.residuals - own->residuals, es) > 2 * options.ambiguity) continue;
       equivalent[c].push_back(g.set[0]);
       ScoredHypothesis& h = S.findings[k];
       for (int id : g.set[0]->site().nodes)
@@ -280,7 +288,7 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   const double best = S.combined.log_evidence;
   for (const SetFit& a : sel.alternatives) {
     if (a.set.size() > sel.fit.set.size()) continue;
-    if (log_evidence(p, a, chi2_0, sel.scale) < best - options.ambiguity || !other_story(a.set)) continue;
+    if (log_evidence(p, a) < best - options.ambiguity || !other_story(a.set)) continue;
     ScoredHypothesis h = score(a, 0);
     h.kind.clear();
     h.description.clear();

@@ -93,6 +93,7 @@ SetFit fit_set(const Problem& p, const std::vector<const Candidate*>& set, const
   out.residuals = s.final_residuals;
   out.chi2_frequency = s.final_chi2_frequency;
   out.information = s.information;
+  out.information_frequency = s.information_frequency;
   out.quality = quality_of(p, s.final_hz, s.final_mac, out.chi2, s.final_forced);
   for (std::size_t k = 0; k < set.size(); ++k) {
     const std::vector<CandidateParameter> ps = set[k]->parameters();
@@ -136,8 +137,9 @@ namespace {
 double normal_cdf(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
 
 // ln of the prior density of one parameter at theta, and its precision (the Laplace approximation's prior term),
-// truncated to the bounds (candidate.hpp). Normal: precision 1 / tau^2. Heavy-tailed: its curvature is negative
-// away from the nominal, so it adds no precision (the data's information alone sets the posterior width). Uniform:
+// truncated to the bounds (candidate.hpp). Normal: precision 1 / tau^2. Heavy-tailed: the density's local width
+// at theta, t + |theta - nominal| (its curvature is negative away from the nominal, but a parameter the data do
+// not see must not earn a posterior wider than its prior: the Occam factor stays at most about 1). Uniform:
 // precision that of a normal of equal variance (12 / width^2), so that an undetermined parameter stays bounded.
 void prior(const CandidateParameter& q, double theta, double* log_density, double* precision) {
   const double w = q.upper - q.lower;
@@ -154,7 +156,7 @@ void prior(const CandidateParameter& q, double theta, double* log_density, doubl
     const double mass = side(q.upper - q.nominal) + side(q.nominal - q.lower);
     const double z = std::abs(theta - q.nominal) / t;
     *log_density = std::log(0.5 / t) - 2.0 * std::log1p(z) - std::log(std::max(mass, 1e-300));
-    *precision = 0.0;
+    *precision = 1.0 / ((t + std::abs(theta - q.nominal)) * (t + std::abs(theta - q.nominal)));
     return;
   }
   const double mass = normal_cdf((q.upper - q.nominal) / t) - normal_cdf((q.lower - q.nominal) / t);
@@ -165,11 +167,67 @@ void prior(const CandidateParameter& q, double theta, double* log_density, doubl
 
 }  // namespace
 
-double log_evidence(const Problem& p, const SetFit& f, double chi2_0, double scale) {
+namespace {
+
+// One data type's prediction-error level, as the variance factor u >= 1 over the noise model's (u = 1 + t^2, t the
+// model-form error in noise units), and the log likelihood at it. Gaussian errors of variance u (n whitened
+// residuals, sum of squares chi2 at u = 1) and a half-normal prior on the model-form error of scale `a` noise units
+// (the form error a hypothesis of the right physics still has): ln L(u) = -(n/2) ln u - chi2/(2u) - (u - 1)/(2a^2),
+// maximized in closed form (u^2 + n a^2 u - chi2 a^2 = 0). Constants common to all hypotheses dropped.
+struct Level {
+  double u = 1, log_likelihood = 0;
+};
+Level level(double chi2, int n, double a) {
+  n = std::max(1, n);
+  const double a2 = a * a;
+  double u = 0.5 * (-n * a2 + std::sqrt(n * a2 * n * a2 + 4 * chi2 * a2));
+  if (!(u > 1)) u = 1;
+  return {u, -0.5 * n * std::log(u) - 0.5 * chi2 / u - 0.5 * (u - 1) / a2};
+}
+
+double form_scale(double form, double noise) { return form / std::max(noise, 1e-12); }
+
+Level frequency_level(const Problem& p, double chi2_frequency) {
+  return level(chi2_frequency, p.modes, form_scale(p.options.form_error_frequency, p.noise.frequency));
+}
+Level shape_level(const Problem& p, double chi2_shape) {
+  return level(chi2_shape, p.n - p.modes, form_scale(p.options.form_error_shape, p.noise.shape));
+}
+
+// ln of the likelihood of the data at a hypothesis's own prediction-error levels.
+double log_likelihood(const Problem& p, double chi2, double chi2_frequency) {
+  return frequency_level(p, chi2_frequency).log_likelihood + shape_level(p, chi2 - chi2_frequency).log_likelihood;
+}
+
+}  // namespace
+
+ErrorScale error_scale(const Problem& p, double chi2, double chi2_frequency) {
+  return {std::sqrt(frequency_level(p, chi2_frequency).u), std::sqrt(shape_level(p, chi2 - chi2_frequency).u)};
+}
+
+double scaled_norm2(const Problem& p, const Eigen::VectorXd& r, const ErrorScale& s) {
+  const Eigen::Index block = 1 + static_cast<Eigen::Index>(p.data.dofs.size());
+  double sum = 0;
+  for (Eigen::Index i = 0; i < r.size(); ++i) sum += r[i] * r[i] / (i % block == 0 ? s.frequency * s.frequency : s.shape * s.shape);
+  return sum;
+}
+
+namespace {
+
+// The inverse posterior covariance from the data at the levels `s` (the prior's precision not included).
+Eigen::MatrixXd data_precision(const SetFit& f, const ErrorScale& s) {
+  const Eigen::MatrixXd& If = f.information_frequency;
+  const Eigen::MatrixXd Is = f.information - If;
+  return If / (s.frequency * s.frequency) + Is / (s.shape * s.shape);
+}
+
+}  // namespace
+
+double log_evidence(const Problem& p, const SetFit& f) {
   if (!f.ok) return -std::numeric_limits<double>::infinity();
-  const double s2 = scale * scale;
+  const ErrorScale s = error_scale(p, f);
   const int k = f.parameters();
-  Eigen::MatrixXd H = f.information / s2;
+  Eigen::MatrixXd H = data_precision(f, s);
   double occam = 0;
   int i = 0;
   for (std::size_t c = 0; c < f.set.size(); ++c) {
@@ -188,21 +246,52 @@ double log_evidence(const Problem& p, const SetFit& f, double chi2_0, double sca
   double logdet = 0;
   for (Eigen::Index j = 0; j < k; ++j) logdet += std::log(std::max(ldlt.vectorD()[j], 1e-300));
   occam += 0.5 * k * std::log(2 * M_PI) - 0.5 * logdet;
-  return (chi2_0 - f.chi2 + f.unpartnered_gain) / (2 * s2) + occam;
+  // The model as given is scored at the noise alone: its form error is what is in question.
+  const double fit = log_likelihood(p, f.chi2, f.chi2_frequency) + 0.5 * p.chi2_0;
+  return fit + f.unpartnered_gain / (2 * s.frequency * s.frequency) + occam;
 }
 
-double significance(const SetFit& f, std::size_t k, double scale) {
+Eigen::VectorXd posterior_stddev(const SetFit& f, const ErrorScale& s) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(data_precision(f, s));
+  const Eigen::VectorXd& ev = es.eigenvalues();
+  const double tol = 1e-12 * std::max(1e-300, ev.size() ? ev.maxCoeff() : 0.0);
+  Eigen::VectorXd inv = Eigen::VectorXd::Zero(ev.size());
+  for (Eigen::Index i = 0; i < ev.size(); ++i)
+    inv[i] = ev[i] > tol ? 1.0 / ev[i] : std::numeric_limits<double>::infinity();
+  Eigen::VectorXd sd(ev.size());
+  for (Eigen::Index j = 0; j < ev.size(); ++j) {
+    double v = 0;
+    for (Eigen::Index i = 0; i < ev.size(); ++i) {
+      const double w = es.eigenvectors()(j, i);
+      if (w != 0) v += w * w * inv[i];
+    }
+    sd[j] = std::sqrt(v);
+  }
+  return sd;
+}
+
+namespace {
+
+Eigen::Index offset_of(const SetFit& f, std::size_t k) {
+  Eigen::Index o = 0;
+  for (std::size_t c = 0; c < k; ++c) o += f.theta[c].size();
+  return o;
+}
+
+}  // namespace
+
+double significance(const Problem& p, const SetFit& f, std::size_t k) {
   if (!f.ok) return 0;
   // The magnitude parameter (the first: a mass, a stiffness, a fraction) against its nominal.
   const CandidateParameter q = f.set[k]->parameters()[0];
-  const double th = f.theta[k][0], sd = f.stddev[k][0] * scale;
+  const double th = f.theta[k][0], sd = posterior_stddev(f, error_scale(p, f))[offset_of(f, k)];
   const double tol = 1e-6 * (q.upper - q.lower);
   if ((std::abs(th - q.lower) < tol && q.lower != q.nominal) || (std::abs(th - q.upper) < tol && q.upper != q.nominal))
     return 0.0;  // on a bound: the hypothesis strains to fit
   return std::isfinite(sd) && sd > 0 ? std::abs(th - q.nominal) / sd : 0.0;
 }
 
-ScoredHypothesis scored(const Problem& p, const SetFit& f, std::size_t k, double scale) {
+ScoredHypothesis scored(const Problem& p, const SetFit& f, std::size_t k) {
   const Candidate& c = *f.set[k];
   ScoredHypothesis h;
   h.kind = c.kind();
@@ -214,13 +303,13 @@ ScoredHypothesis scored(const Problem& p, const SetFit& f, std::size_t k, double
   h.fitted = f.ok;
   if (!f.ok) return h;
   h.chi2 = f.chi2;
-  // Reported standard deviations: the statistical one at the larger of the evidence's noise scale and the
-  // frequencies' own (a candidate that approximates the real physics misfits the frequencies far more than the
-  // shapes, and the values rest on the frequencies), with the candidate's model-form uncertainty, `model_form`
-  // of its change from nominal, in quadrature.
-  const double sf = std::sqrt(std::max(1.0, f.chi2_frequency / std::max(1, p.modes - f.parameters())));
+  // Reported standard deviations: the posterior's at the set's error levels, the frequencies' counted over the
+  // degrees of freedom the fit leaves them (the values rest on the frequencies), with the candidate's model-form
+  // uncertainty, `model_form` of its change from nominal, in quadrature.
+  ErrorScale s = error_scale(p, f);
+  s.frequency = std::max(s.frequency, std::sqrt(std::max(1.0, f.chi2_frequency / std::max(1, p.modes - f.parameters()))));
   const std::vector<CandidateParameter> ps = c.parameters();
-  Eigen::VectorXd sd = f.stddev[k] * std::max(scale, sf);
+  Eigen::VectorXd sd = posterior_stddev(f, s).segment(offset_of(f, k), f.theta[k].size());
   for (Eigen::Index q = 0; q < sd.size(); ++q)
     sd[q] = std::hypot(sd[q], p.options.model_form * std::abs(f.theta[k][q] - ps[static_cast<std::size_t>(q)].nominal));
   h.values = c.physical(f.theta[k], sd);

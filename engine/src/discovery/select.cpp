@@ -25,7 +25,7 @@ struct Search {
   const Problem& p;
   double chi2_0;
   FitQuality before;
-  double scale = 1, chi2_best = 0;
+  double chi2_best = 0;
   int solves = 0;
   std::map<std::vector<const Candidate*>, SetFit> cache;  // by the set's candidates, sorted
 
@@ -56,7 +56,7 @@ struct Search {
     return *find(s);
   }
 
-  double evidence(const SetFit& f) const { return log_evidence(p, f, chi2_0, scale); }
+  double evidence(const SetFit& f) const { return log_evidence(p, f); }
   // Share of the misfit removed, relative to the best any explored set reached (reported).
   double explained(const SetFit& f) const {
     const double span = chi2_0 - chi2_best;
@@ -70,7 +70,7 @@ struct Search {
     if (f.quality.max_freq_error_pct > before.max_freq_error_pct || f.quality.mean_mac < before.mean_mac - kMacTolerance) return false;
     if (2 * f.parameters() > std::max(2, p.modes)) return false;
     for (std::size_t k = 0; k < f.set.size(); ++k)
-      if (significance(f, k, scale) < p.options.min_significance) return false;
+      if (significance(p, f, k) < p.options.min_significance) return false;
     return true;
   }
   // Whether adding one effect to `from` (giving `to`) is worth it: decisive, removing `further` of the misfit
@@ -159,19 +159,18 @@ SelectionStep step_of(const Search& s, SelectionStep::Action a, const std::strin
 Selection select(const Problem& p, const std::vector<SetFit>& singles, double chi2_0, const FitQuality& before) {
   Search s{p, chi2_0, before};
   for (const SetFit& f : singles) s.cache.emplace(Search::key(f.set), f);
-  auto update_scale = [&]() {
+  auto update_best = [&]() {
     s.chi2_best = chi2_0;
-    int k_best = 0;
     for (const auto& [k, f] : s.cache)
-      if (f.ok && !f.at_bound && f.chi2 < s.chi2_best) s.chi2_best = f.chi2, k_best = f.parameters();
-    s.scale = std::sqrt(std::max(1.0, s.chi2_best / std::max(1, p.n - k_best)));
+      if (f.ok && !f.at_bound && f.chi2 < s.chi2_best) s.chi2_best = f.chi2;
   };
-  update_scale();
+  update_best();
 
-  // Starts: the best admissible, decisive single candidates telling different stories.
+  // Starts: the best admissible single candidates telling different stories, each better than the model as given
+  // (one effect of two may not be decisive alone; the explanation it starts must be).
   std::vector<const SetFit*> ranked;
   for (const SetFit& f : singles)
-    if (s.admissible(f) && s.evidence(f) >= p.options.decisive) ranked.push_back(s.find(f.set));
+    if (s.admissible(f) && s.evidence(f) > 0) ranked.push_back(s.find(f.set));
   std::stable_sort(ranked.begin(), ranked.end(), [&](const SetFit* a, const SetFit* b) { return s.evidence(*a) > s.evidence(*b); });
   std::vector<const SetFit*> starts;
   for (const SetFit* f : ranked) {
@@ -207,7 +206,7 @@ Selection select(const Problem& p, const std::vector<SetFit>& singles, double ch
     }
     chains.push_back(chain);
   }
-  update_scale();
+  update_best();
 
   // Walk each chain: each step must be worth it, and earlier effects must keep their place.
   std::vector<ChainResult> results;
@@ -240,13 +239,12 @@ Selection select(const Problem& p, const std::vector<SetFit>& singles, double ch
       if (removed) break;  // the chain's later effects were grown beside the removed one
     }
     r.fit = cur;
-    results.push_back(r);
+    if (s.evidence(*cur) >= p.options.decisive) results.push_back(r);
   }
 
   Selection sel;
   if (results.empty()) {
     sel.chi2_best = s.chi2_best;
-    sel.scale = s.scale;
     sel.eigen_solves = s.solves;
     return sel;
   }
@@ -275,7 +273,6 @@ Selection select(const Problem& p, const std::vector<SetFit>& singles, double ch
   }
   for (std::size_t k = 1; k < results.size(); ++k) sel.alternatives.push_back(*results[k].fit);
   sel.chi2_best = s.chi2_best;
-  sel.scale = s.scale;
   sel.eigen_solves = s.solves;
   return sel;
 }

@@ -60,6 +60,8 @@ struct Problem {
   int kinds = 1;                   ///< kinds in the library (the prior of an effect's kind)
   int n = 0;                       ///< whitened residuals
   int modes = 0;                   ///< measured modes used
+  double chi2_0 = 0;               ///< the model as given: whitened residual sum of squares
+  double chi2_0_frequency = 0;     ///< its frequency part
 };
 
 /// A set of candidates fitted together.
@@ -71,6 +73,7 @@ struct SetFit {
   double chi2_frequency = 0;       ///< its frequency part
   Eigen::VectorXd residuals;       ///< the whitened residuals at the solution (what the set predicts, less the data)
   Eigen::MatrixXd information;     ///< J^T J over the set's parameters (whitened at the stated noise)
+  Eigen::MatrixXd information_frequency;  ///< its frequency rows' part
   FitQuality quality;
   /// Sum over the unpartnered modes this set pairs of (log-density gain, prepare.cpp): evidence from modes the
   /// model as given lacks.
@@ -112,12 +115,27 @@ SetFit fit_set(const Problem& p, const std::vector<const Candidate*>& set, const
 double unpartnered_gain(const Problem& p, const ParametricModel& pm, const Eigen::VectorXd& theta);
 FitQuality quality_of(const Problem& p, const Eigen::VectorXd& model_hz, const Eigen::VectorXd& mac, double chi2,
                       const std::vector<char>& nominal_paired);
-/// ln Bayes factor of a fitted set against the model as given (chi2_0), with the noise scaled by `scale`.
-double log_evidence(const Problem& p, const SetFit& f, double chi2_0, double scale);
-/// Smallest |theta - nominal| / std over the set's parameters of candidate k (std scaled by `scale`); 0 on a bound.
-double significance(const SetFit& f, std::size_t k, double scale);
-/// One candidate of a fitted set as reported: its values with standard deviations scaled by `scale`.
-ScoredHypothesis scored(const Problem& p, const SetFit& f, std::size_t k, double scale);
+/// The prediction-error level of each data type under a fitted set, in units of the noise model's (>= 1): the most
+/// likely level given the set's misfit and a half-normal prior on the model-form error (scale
+/// DiscoveryOptions::form_error_frequency / form_error_shape). A hypothesis that approximates the real physics
+/// misfits the frequencies beyond their measurement noise; it is scored at that level, not at the measurement's
+/// (Beck & Yuen 2004: the prediction-error variance belongs to the model class).
+struct ErrorScale {
+  double frequency = 1, shape = 1;
+};
+ErrorScale error_scale(const Problem& p, double chi2, double chi2_frequency);
+inline ErrorScale error_scale(const Problem& p, const SetFit& f) { return error_scale(p, f.chi2, f.chi2_frequency); }
+/// Sum of squares of whitened residuals (mode by mode: the frequency, then the shape entries) at the levels `s`.
+double scaled_norm2(const Problem& p, const Eigen::VectorXd& r, const ErrorScale& s);
+/// ln Bayes factor of a fitted set against the model as given (Problem::chi2_0), each with its own prediction-error
+/// levels (error_scale), with a Laplace approximation of the parameters' posterior.
+double log_evidence(const Problem& p, const SetFit& f);
+/// Posterior standard deviations of a set's parameters (all candidates in order) at the levels `s`.
+Eigen::VectorXd posterior_stddev(const SetFit& f, const ErrorScale& s);
+/// Smallest |theta - nominal| / std over the set's parameters of candidate k (at the set's levels); 0 on a bound.
+double significance(const Problem& p, const SetFit& f, std::size_t k);
+/// One candidate of a fitted set as reported: its values with their standard deviations.
+ScoredHypothesis scored(const Problem& p, const SetFit& f, std::size_t k);
 /// Whether two candidates tell the same story: the same global kind, or local ones of compatible nature (mass
 /// with mass, stiffness with stiffness; "both" with either) at sites that share a node.
 bool same_story(const Model& m, const Candidate& a, const Candidate& b);
@@ -131,7 +149,6 @@ struct Selection {
   std::vector<SelectionStep> steps;
   std::vector<SetFit> alternatives;  ///< the other starts' complete explanations (rival candidates)
   double chi2_best = 0;            ///< the lowest chi-square any explored set reached
-  double scale = 1;                ///< noise scale of the evidence
   int eigen_solves = 0;
 };
 Selection select(const Problem& p, const std::vector<SetFit>& singles, double chi2_0, const FitQuality& before);

@@ -64,6 +64,10 @@ struct DiscoveryOptions {
   /// stub, a point mass for a block), so its reported standard deviation has this share of its change from
   /// nominal added in quadrature (docs/method.md).
   double model_form = 0.05;
+  /// The form error a hypothesis of the right physics still has in the frequencies (relative) and in the shape
+  /// entries (relative to each mode's largest): the scale of the half-normal prior on each data type's model-form
+  /// error, which every hypothesis, the model as given included, is scored with at its most likely level.
+  double form_error_frequency = 0.0025, form_error_shape = 0.02;
   /// A further effect's parameters must differ from nominal by this many standard deviations.
   double min_significance = 3.0;
   int max_iterations = 100;        ///< Ceres iterations per fit
@@ -200,7 +204,10 @@ struct DiscoverySummary {
   double explained = 0;
   int data = 0;                    ///< whitened residuals (frequencies + shape entries)
   double chi2_frequency_before = 0, chi2_shape_before = 0;  ///< per datum, at the noise model's levels
-  double noise_scale = 1;          ///< sqrt of the misfit per datum nothing explains (>= 1): the evidence's noise
+  /// The explanation's prediction-error levels, in units of the noise model's (>= 1): its misfit per frequency
+  /// and per shape entry where larger than the noise (the model as given's when nothing is found). Each hypothesis
+  /// is scored at its own levels (DiscoveryOptions: the evidence).
+  double noise_scale_frequency = 1, noise_scale_shape = 1;
   int eigen_solves = 0;
   double seconds = 0;
   std::vector<std::string> warnings;

@@ -83,6 +83,7 @@ struct FitSummary {
   /// J^T J of the whitened residuals over the free parameters at the solution (without regularization): the
   /// inverse posterior covariance at the stated noise (Laplace approximations of the evidence).
   Eigen::MatrixXd information;
+  Eigen::MatrixXd information_frequency;  ///< the frequency residuals' part of `information`
   double final_chi2_frequency = 0;  ///< the frequency residuals' part of 2 final_cost
   Eigen::VectorXd final_residuals;  ///< the whitened residuals at the solution, mode by mode (as linearize())
   std::vector<char> final_forced;   ///< per measured mode: paired below min_mac (or the ratio bound) at the solution
