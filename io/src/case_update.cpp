@@ -49,7 +49,7 @@ UpdateSpec parse_update(const YAML::Node& n, const YamlCtx& ctx, const Model& mo
   if (n["measured"] && n["target"]) ctx.fail(n, "update: give either measured: (a file) or target: (a simulation), not both");
   if (!n["measured"] && !n["target"]) ctx.fail(n, "update: the measured data are missing: give measured: FILE or target: {...}");
   if (n["measured"]) u.measured_file = parse_measured(n["measured"], ctx, dir, "update measured");
-  u.measured_mat = parse_measured_mat(n, "update", ctx);
+  u.measured_mat = parse_measured_mat(n, "update", ctx, dir);
   u.geometry = internal::parse_geometry(n, "update", ctx, dir);
   if (n["target"]) {
     const YAML::Node& t = n["target"];

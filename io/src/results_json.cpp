@@ -71,7 +71,9 @@ UpdateRun update_case(const Case& c) {
   run.measured = update_measured_data(c);
   run.pm = std::make_unique<ParametricModel>(c.model);
   for (const Parameter& p : u.parameters) run.pm->add(p);
-  run.fit = fit_parameters(*run.pm, run.measured, u.initial, u.free, u.options);
+  const MeasuredNoise noise = measured_noise(run.measured, u.options);
+  run.fit = fit_parameters(*run.pm, run.measured, u.initial, u.free, noise.options);
+  run.fit.warnings.insert(run.fit.warnings.begin(), noise.warnings.begin(), noise.warnings.end());
   return run;
 }
 
