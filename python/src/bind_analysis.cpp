@@ -339,7 +339,7 @@ void bind_analysis(py::module_& mod) {
       for (const Parameter& p : u.parameters) run.pm->add(p);
       run.fit = fit_parameters(*run.pm, run.measured, u.initial, u.free, u.options);
     }
-    py::dict d = to_python(update_json(c->name, *run.pm, *c->update, run.fit)).cast<py::dict>();
+    py::dict d = to_python(update_json(c->name, *run.pm, *c->update, run.fit, run.search ? &*run.search : nullptr)).cast<py::dict>();
     d["theta"] = move_array(Eigen::VectorXd(run.fit.theta));
     return d;
   });
