@@ -145,6 +145,10 @@ MultiStartSummary fit_multistart(const ParametricModel& pm, const ModalData& mea
   }
   out.best_start = order.front();
   out.best = std::move(fits[static_cast<std::size_t>(out.best_start)]);
+  // "initial" means the user's values, not the best start's point.
+  const Correlation c0 = correlate(pm, measured, theta0, o);
+  out.best.initial_hz = c0.model_hz;
+  out.best.initial_mac = c0.mac;
   if (out.failed > 0)
     out.warnings.push_back(std::to_string(out.failed) + " of " + std::to_string(n) + " starts failed (the model could not be "
                            "evaluated there): " + out.start_error[static_cast<std::size_t>(

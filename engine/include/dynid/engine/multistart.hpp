@@ -40,7 +40,8 @@ struct LocalMinimum {
 };
 
 struct MultiStartSummary {
-  FitSummary best;               ///< the full fit of the start with the lowest cost
+  FitSummary best;               ///< the full fit of the start with the lowest cost (initial_hz, initial_mac:
+                                 ///< at the user's initial values, as for a single fit)
   int best_start = -1;
   std::vector<LocalMinimum> minima;          ///< distinct minima, lowest cost first
   std::vector<Eigen::VectorXd> start_points; ///< every start (all parameters)
