@@ -64,11 +64,11 @@ nlohmann::json detect_json(const std::string& case_name, const DetectSummary& S)
   return j;
 }
 
-UpdateRun update_case(const Case& c) {
+UpdateRun update_case(const Case& c, const ModalData* measured) {
   require_section(c, c.update.has_value(), "update");
   const UpdateSpec& u = *c.update;
   UpdateRun run;
-  run.measured = update_measured_data(c);
+  run.measured = measured ? first_modes(*measured, u.modes) : update_measured_data(c);
   run.pm = std::make_unique<ParametricModel>(c.model);
   for (const Parameter& p : u.parameters) run.pm->add(p);
   const MeasuredNoise noise = measured_noise(run.measured, u.options);

@@ -32,7 +32,8 @@ struct UpdateRun {
   FitSummary fit;                        ///< the fit (with multistart: the best start's)
   std::optional<MultiStartSummary> search;  ///< the global search, when the case asks for it
 };
-UpdateRun update_case(const Case& c);
+/// `measured`, when given, replaces the case's measured data (a host's own modes; the first update: modes used).
+UpdateRun update_case(const Case& c, const ModalData* measured = nullptr);
 
 /// The update results JSON: {"case", "parameters", "frequencies_hz", "mac", "objective", "iterations",
 /// "model_evaluations", "cost", "termination", "converged", "covariance", "warnings"}. `u` gives the initial
