@@ -88,6 +88,7 @@ int run_update(const UpdateArgs& a, const GlobalOptions& g) {
   const Case c = load_case(a.case_path);
   require_section(c, c.update.has_value(), "update");
   const UpdateSpec& u = *c.update;
+  if (u.multistart) set_blas_threads(1);
   Progress progress(!g.quiet);
   progress.update("updating", -1);
   const UpdateRun run = update_case(c);
@@ -99,6 +100,19 @@ int run_update(const UpdateArgs& a, const GlobalOptions& g) {
     fmt::print("dynid update: {} — {} parameters ({} free), {} measured modes at {} DOFs, objective {}\n", c.name,
                pm.num_parameters(), f.free_parameters, measured.num_modes(), measured.dofs.size(),
                fit_objective_name(u.options.objective));
+    if (run.search) {
+      const MultiStartSummary& s = *run.search;
+      fmt::print("  global search: {} starts (start 0: the initial values; the others a Latin hypercube within the bounds, "
+                 "seed {}{}), {} failed, {} distinct minima; {:.1f} s wall, {:.1f} s CPU\n", s.start_points.size(), u.search.seed,
+                 u.search.continuation ? ", frequency-only first" : "", s.failed, s.minima.size(), s.time_wall, s.time_cpu);
+      fmt::print("  minimum  cost        starts  max freq err %  mean MAC  on bounds\n");
+      for (std::size_t m = 0; m < s.minima.size(); ++m) {
+        const LocalMinimum& lm = s.minima[m];
+        fmt::print("  {:7d}  {:<10.5g}  {:6d}  {:14.3f}  {:8.4f}  {:9d}{}\n", m + 1, lm.cost, lm.starts.size(),
+                   100 * lm.max_frequency_error, lm.mean_mac, lm.at_bound, lm.converged ? "" : "  (not converged)");
+      }
+      fmt::print("  the best minimum (start {}):\n", s.best_start);
+    }
     fmt::print("  Ceres: {} iterations, {} model evaluations, cost {:.4g} -> {:.4g}, {}\n", f.iterations, f.evaluations,
                f.initial_cost, f.final_cost, f.termination);
     fmt::print("  parameter            initial      updated      std (stated noise)  std (a posteriori, x{:.3g})\n",
@@ -116,7 +130,7 @@ int run_update(const UpdateArgs& a, const GlobalOptions& g) {
     for (const std::string& w : f.warnings) fmt::print(stderr, "dynid update: warning: {}\n", w);
   }
   if (!a.json.empty()) {
-    write_file_atomic(a.json, update_json(c.name, pm, u, f).dump(1) + "\n", a.force);
+    write_file_atomic(a.json, update_json(c.name, pm, u, f, run.search ? &*run.search : nullptr).dump(1) + "\n", a.force);
     const std::string png = a.plot.empty() ? std::filesystem::path(a.json).replace_extension(".png").string() : a.plot;
     plot::save(update_figure(c, pm, u, f), png, a.force);
   } else if (!a.plot.empty()) {

@@ -23,6 +23,10 @@ void set_threads(int n) {
   omp_set_num_threads(n);
 #endif
   // OpenBLAS (used by CHOLMOD's supernodal factorization) has its own thread pool.
+  set_blas_threads(n);
+}
+
+void set_blas_threads(int n) {
   using SetThreads = void (*)(int);
   if (auto f = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) f(n);
 }

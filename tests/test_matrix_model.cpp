@@ -13,6 +13,7 @@
 #include "dynid/io/case_file.hpp"
 #include "dynid/io/matrix_market.hpp"
 #include "dynid/io/matrix_model.hpp"
+#include "dynid/io/point_map.hpp"
 #include "test_util.hpp"
 
 namespace dynid {
@@ -182,6 +183,57 @@ TEST_F(MatrixFolder, GroupsAndRemainder) {
   for (int k = 0; k < 8; ++k) EXPECT_TRUE(test::RelClose(f1[k], f0[k], 1e-10)) << "remainder, mode " << k + 1;
   // The complete element file against K and M: no remainder.
   EXPECT_TRUE(Load("    dofs: dofs.csv\n    nodes: nodes.csv\n    elements: elements.txt\n    K: K.mtx\n    M: M.mtx\n").notes.empty());
+}
+
+// Matrix input without friction (issue 19): a stiffness-only and a mass-only group (K.mtx, M.mtx as groups, no
+// empty files) and no node table give the frame's frequencies (1e-10 as above); the missing coordinates are said
+// once, and matching test points by position is refused with the reason.
+TEST_F(MatrixFolder, StiffnessOnlyMassOnlyGroupsWithoutCoordinates) {
+  const Eigen::VectorXd f0 = Frequencies(load_case(test::CasesDir() + "/paper-frame").model);
+  const Case c = Load("    dofs: dofs.csv\n    groups:\n      stiffness: {K: K.mtx}\n      mass: {M: M.mtx}\n");
+  ASSERT_EQ(c.model.num_elements(), 2);
+  const Eigen::VectorXd f1 = Frequencies(c.model);
+  for (int k = 0; k < 8; ++k) EXPECT_TRUE(test::RelClose(f1[k], f0[k], 1e-10)) << "mode " << k + 1;
+  ASSERT_EQ(c.notes.size(), 1u);
+  EXPECT_HAS(c.notes[0], "no node table (nodes:)");
+  for (const Node& nd : c.model.nodes()) EXPECT_EQ(nd.x, Eigen::Vector3d::Zero());
+  UffFile geo;
+  geo.source = "points.uff";
+  UffNodes pts;
+  pts.nodes.resize(1);
+  geo.datasets.push_back(UffDataset{15, 1, pts});
+  EXPECT_HAS(ErrorOf([&] { map_test_points(c.model, geo, GeometrySpec{}); }),
+             "points.uff: test points cannot be matched by position: the model's nodes have no coordinates");
+  EXPECT_HAS(ErrorOf([&] { Load("    dofs: dofs.csv\n    groups:\n      nothing: {}\n"); }), "give K, M or both");
+}
+
+// The K/M consistency check with exact sums: the groups add up to the given K except for exporter rounding in
+// entries where large contributions cancel (an entry that should be 0 holds 1e-13 of its row's scale in K.mtx
+// and 3e-13 in the group, as SAP2000's influence matrices do): no remainder element. A real difference of 1e-6
+// of the row's scale still is one (the tolerance is 1e-9 of the row's and column's largest entries).
+TEST_F(MatrixFolder, ExactSumsGiveNoRemainder) {
+  SparseMatrix K = read_matrix_market(Path("K.mtx"));
+  const int i = 0;
+  int j = -1;  // an equation not coupled to equation 0
+  for (int q = 1; q < K.cols() && j < 0; ++q)
+    if (K.coeff(i, q) == 0.0 && K.coeff(i, i) != 0.0 && K.coeff(q, q) != 0.0) j = q;
+  ASSERT_GE(j, 0);
+  const double s = std::max(std::abs(K.coeff(i, i)), std::abs(K.coeff(j, j)));
+  auto with = [&](double v, const std::string& f) {
+    SparseMatrix A = K;
+    A.coeffRef(i, j) = v;
+    A.coeffRef(j, i) = v;
+    write_matrix_market(Path(f), A, true, true);
+  };
+  with(3e-13 * s, "Kg.mtx");
+  with(1e-13 * s, "Kx.mtx");
+  const std::string groups = "    dofs: dofs.csv\n    groups:\n      stiffness: {K: Kg.mtx}\n      mass: {M: M.mtx}\n    M: M.mtx\n";
+  const Case exact = Load(groups + "    K: Kx.mtx\n");
+  EXPECT_EQ(exact.model.num_elements(), 2);
+  for (const std::string& n : exact.notes) EXPECT_EQ(n.find("remainder"), std::string::npos) << n;
+  with(1e-6 * s, "Kd.mtx");
+  const Case differs = Load(groups + "    K: Kd.mtx\n");
+  EXPECT_EQ(differs.model.num_elements(), 3);
 }
 
 // Each malformed input gets a message naming the file, the line where there is one, and what to do.

@@ -34,6 +34,22 @@ void ModalData::validate(const std::string& what) const {
   };
   non_negative(frequency_std_hz, "frequency standard deviation");
   non_negative(shape_std, "shape standard deviation");
+  if (shape_entry_std.size() != 0) {
+    if (shape_entry_std.rows() != shapes.rows() || shape_entry_std.cols() != m)
+      throw InputError(what + ": shape entry standard deviations are " + std::to_string(shape_entry_std.rows()) + " x " +
+                       std::to_string(shape_entry_std.cols()) + " for shapes of " + std::to_string(shapes.rows()) + " DOFs x " +
+                       std::to_string(m) + " modes; give one per shape entry");
+    for (Eigen::Index k = 0; k < m; ++k)
+      for (Eigen::Index i = 0; i < shapes.rows(); ++i)
+        if (!std::isfinite(shape_entry_std(i, k)) || shape_entry_std(i, k) < 0)
+          throw InputError(what + ": mode " + std::to_string(k + 1) + " has shape standard deviation " +
+                           std::to_string(shape_entry_std(i, k)) + " at DOF " + to_string(dofs[static_cast<std::size_t>(i)]) +
+                           "; standard deviations must be finite and >= 0");
+    for (Eigen::Index k = 0; k < m; ++k)
+      if ((shape_entry_std.col(k).array() > 0).count() == 0)
+        throw InputError(what + ": mode " + std::to_string(k + 1) + " has a standard deviation of 0 at every shape entry; "
+                         "only the entry a mode is normalised by is exact");
+  }
   for (Eigen::Index k = 0; k < m; ++k) {
     if (!std::isfinite(frequencies_hz[k]) || frequencies_hz[k] <= 0)
       throw InputError(what + ": mode " + std::to_string(k + 1) + " has frequency " + std::to_string(frequencies_hz[k]) +

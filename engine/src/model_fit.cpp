@@ -37,6 +37,11 @@ bool FitOptions::IsValid(std::string* why) const {
   for (const Eigen::VectorXd* v : {&frequency_noise_modes, &shape_noise_modes})
     for (Eigen::Index k = 0; k < v->size(); ++k)
       if (!((*v)[k] > 0) || !std::isfinite((*v)[k])) return fail("per-mode noise levels must be finite and > 0");
+  if (!shape_noise_entries.allFinite() || (shape_noise_entries.array() < 0).any())
+    return fail("per-entry shape noise levels must be finite and >= 0");
+  for (Eigen::Index k = 0; k < shape_noise_entries.cols(); ++k)
+    if ((shape_noise_entries.col(k).array() > 0).count() == 0)
+      return fail("per-entry shape noise: every mode needs at least one entry with a std > 0");
   if (!(regularization >= 0)) return fail("regularization must be >= 0");
   if (!(loss_scale > 0)) return fail("loss_scale must be > 0");
   if (max_iterations < 0) return fail("max_iterations must be >= 0");
@@ -80,6 +85,11 @@ class Evaluator {
       if (v->size() != 0 && v->size() != meas.num_modes())
         throw InputError("fit: " + std::to_string(v->size()) + " per-mode noise levels for " + std::to_string(meas.num_modes()) +
                          " measured modes");
+    if (o.shape_noise_entries.size() != 0 &&
+        (o.shape_noise_entries.rows() != static_cast<Eigen::Index>(meas.dofs.size()) || o.shape_noise_entries.cols() != meas.num_modes()))
+      throw InputError("fit: per-entry shape noise is " + std::to_string(o.shape_noise_entries.rows()) + " x " +
+                       std::to_string(o.shape_noise_entries.cols()) + " for " + std::to_string(meas.dofs.size()) + " DOFs x " +
+                       std::to_string(meas.num_modes()) + " measured modes");
     rows_ = measured_equations(pm.model(), meas.dofs);
     const Model& model = pm.model();
     for (int n = 0; n < static_cast<int>(model.nodes().size()); ++n)
@@ -112,6 +122,27 @@ class Evaluator {
     for (Eigen::Index k = 0; k < U_.cols(); ++k) U_.col(k) /= U_.col(k).cwiseAbs().maxCoeff();
     lam_meas_.resize(p);
     for (int k = 0; k < p; ++k) lam_meas_[k] = hz_to_eigenvalue(meas.frequencies_hz[k]);
+    // Shape residual weights (1 / std; 0 for exact entries) and the weights of the model shape's scale c:
+    // weighted least squares (1 / std^2), or, when a mode has exact entries, least squares over those alone
+    // (the limit of infinite weight: the scaled model shape matches them).
+    const Eigen::Index a = static_cast<Eigen::Index>(rows_.size());
+    w_res_.resize(a, p);
+    w_scale_.resize(a, p);
+    exact_entries_ = 0;
+    for (int k = 0; k < p; ++k) {
+      if (o.shape_noise_entries.size() == 0) {
+        w_res_.col(k).setConstant(1.0 / shape_noise(k));
+        w_scale_.col(k).setOnes();
+        continue;
+      }
+      const Eigen::ArrayXd sd = o.shape_noise_entries.col(k).array();
+      const bool exact = (sd == 0).any();
+      for (Eigen::Index r = 0; r < a; ++r) {
+        w_res_(r, k) = sd[r] > 0 ? 1.0 / sd[r] : 0.0;
+        w_scale_(r, k) = exact ? (sd[r] == 0 ? 1.0 : 0.0) : 1.0 / (sd[r] * sd[r]);
+      }
+      exact_entries_ += static_cast<int>((sd == 0).count());
+    }
     m_serep_ = std::min<int>(static_cast<int>(rows_.size()), eo.num_modes);
   }
 
@@ -149,6 +180,8 @@ class Evaluator {
       default: return 1;
     }
   }
+  /// Data values that carry a residual (exact shape entries do not).
+  int data_values() const { return meas_.num_modes() * rows_per_mode() - (o_.objective == FitObjective::kCombined ? exact_entries_ : 0); }
   int evaluations() const { return evaluations_; }
   double time_eigen() const { return time_eigen_; }
   double time_sensitivity() const { return time_sens_; }
@@ -273,7 +306,13 @@ class Evaluator {
   double frequency_noise(int k) const {
     return o_.frequency_noise_modes.size() == meas_.num_modes() ? o_.frequency_noise_modes[k] : o_.frequency_noise;
   }
-  double shape_noise(int k) const { return o_.shape_noise_modes.size() == meas_.num_modes() ? o_.shape_noise_modes[k] : o_.shape_noise; }
+  double shape_noise(int k) const {
+    if (o_.shape_noise_entries.cols() == meas_.num_modes()) {  // f2: the RMS of the mode's inexact entries
+      const Eigen::ArrayXd sd = o_.shape_noise_entries.col(k).array();
+      return std::sqrt((sd * sd).sum() / static_cast<double>((sd > 0).count()));
+    }
+    return o_.shape_noise_modes.size() == meas_.num_modes() ? o_.shape_noise_modes[k] : o_.shape_noise;
+  }
   double sigma_lambda(int k) const { return 2.0 * frequency_noise(k) * lam_meas_[k]; }
 
   void residuals() {
@@ -303,11 +342,16 @@ class Evaluator {
       }
       Eigen::VectorXd v(a);
       for (Eigen::Index r = 0; r < a; ++r) v[r] = ev_.ms.Phi(rows_[r], i);
-      const double c = U_.col(k).dot(v) / v.squaredNorm();
+      const double c = shape_scale(k, v);
       ev_.r[k].resize(1 + a);
       ev_.r[k][0] = rf;
-      ev_.r[k].tail(a) = (c * v - U_.col(k)) / shape_noise(k);
+      ev_.r[k].tail(a) = w_res_.col(k).cwiseProduct(c * v - U_.col(k));
     }
+  }
+
+  // The scale c of model shape v that best matches measured mode k (weighted least squares, see w_scale_).
+  double shape_scale(int k, const Eigen::VectorXd& v) const {
+    return w_scale_.col(k).cwiseProduct(U_.col(k)).dot(v) / w_scale_.col(k).cwiseProduct(v).dot(v);
   }
 
   // SEREP of the current model to the measured DOFs with the lowest m modes: P = Phi_a^+ (m x a).
@@ -363,21 +407,23 @@ class Evaluator {
       double w = 1.0 / sigma_lambda(k);
       if (o_.objective == FitObjective::kFrequencyMac) w /= std::max(ev_.mac[k], 1e-3);
       Eigen::MatrixXd Jk(rows_per_mode(), nf);
-      Eigen::VectorXd v(a);
+      Eigen::VectorXd v(a), wv, wu;
       double vv = 1, c = 0;
       if (o_.objective == FitObjective::kCombined) {
         const int i = ev_.pair[k];
         for (Eigen::Index r = 0; r < a; ++r) v[r] = ev_.ms.Phi(rows_[r], i);
-        vv = v.squaredNorm();
-        c = U_.col(k).dot(v) / vv;
+        wv = w_scale_.col(k).cwiseProduct(v);
+        wu = w_scale_.col(k).cwiseProduct(U_.col(k));
+        vv = wv.dot(v);
+        c = wu.dot(v) / vv;
       }
       auto col = [&](int q) -> Eigen::VectorXd {
         Eigen::VectorXd out(rows_per_mode());
         out[0] = dlam(k, q) * w;
-        if (o_.objective == FitObjective::kCombined) {
+        if (o_.objective == FitObjective::kCombined) {  // c = (u' W v) / (v' W v)
           const Eigen::VectorXd dv = dphi[k].col(q);
-          const double dc = U_.col(k).dot(dv) / vv - 2.0 * c * v.dot(dv) / vv;
-          out.tail(a) = (dc * v + c * dv) / shape_noise(k);
+          const double dc = wu.dot(dv) / vv - 2.0 * c * wv.dot(dv) / vv;
+          out.tail(a) = w_res_.col(k).cwiseProduct(dc * v + c * dv);
         }
         return out;
       };
@@ -400,6 +446,8 @@ class Evaluator {
   bool may_tie_ = false;            // springs or custom terms may tie the rigid-body motions down
   bool complete_ = false;
   Eigen::MatrixXd U_;
+  Eigen::MatrixXd w_res_, w_scale_;  // per shape entry and mode: residual weight, weight in the scale c
+  int exact_entries_ = 0;            // shape entries with std 0 (no residual)
   Eigen::VectorXd lam_meas_;
   int m_serep_ = 0;
   Eigen::MatrixXd Phi_a_, G_, Ps_;
@@ -478,6 +526,38 @@ Eigen::VectorXd paired_hz(const Evaluation& e) {
 }
 
 }  // namespace
+
+MeasuredNoise measured_noise(const ModalData& d, const FitOptions& options) {
+  MeasuredNoise m;
+  m.options = options;
+  FitOptions& o = m.options;
+  const int p = d.num_modes();
+  auto pct = [](double v) {
+    std::ostringstream s;
+    s << 100 * v;
+    return s.str();
+  };
+  if (d.frequency_std_hz.size() == p && p > 0 && (d.frequency_std_hz.array() > 0).all()) {
+    o.frequency_noise_modes = d.frequency_std_hz.cwiseQuotient(d.frequencies_hz);
+    m.frequency = true;
+  } else {
+    m.warnings.push_back("the measured data carry no frequency standard deviations (or a zero one): the stated frequency "
+                         "noise applies (" + pct(o.frequency_noise) + " % for every mode)");
+  }
+  if (d.shape_entry_std.cols() == p && d.shape_entry_std.rows() == d.shapes.rows() && p > 0) {
+    o.shape_noise_entries = d.shape_entry_std;
+    for (int k = 0; k < p; ++k) o.shape_noise_entries.col(k) /= d.shapes.col(k).cwiseAbs().maxCoeff();
+    o.shape_noise_modes.resize(0);
+    m.shape = true;
+  } else if (d.shape_std.size() == p && p > 0 && (d.shape_std.array() > 0).all()) {
+    o.shape_noise_modes = d.shape_std;
+    m.shape = true;
+  } else {
+    m.warnings.push_back("the measured data carry no shape standard deviations: the stated shape noise applies (" +
+                         pct(o.shape_noise) + " % of each mode's largest entry, for every entry)");
+  }
+  return m;
+}
 
 FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta0,
                           const std::vector<char>& is_free, const FitOptions& o) {
@@ -645,7 +725,7 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
                              std::to_string(nf) + " free parameters (J^T J is rank-deficient): the others trade off "
                              "against each other; fix or tie parameters, or add modes or DOFs");
   }
-  const int ndata = measured.num_modes() * ev->rows_per_mode();
+  const int ndata = ev->data_values();
   if (ndata > nf) out.residual_scale = std::sqrt(2.0 * out.final_cost / (ndata - nf));
   if (nf > ndata)
     out.warnings.push_back(std::to_string(nf) + " free parameters but only " + std::to_string(ndata) + " data values");

@@ -61,7 +61,7 @@ DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model
   const int sources = !!n["measured"] + !!n["recordings"] + !!n["truth"];
   if (sources != 1) ctx.fail(n, "discover: give exactly one of measured: FILE (modal data), recordings: [FILES] or truth: {model:, test:}");
   if (n["measured"]) d.measured_file = parse_measured(n["measured"], ctx, dir, "discover measured");
-  d.measured_mat = parse_measured_mat(n, "discover", ctx);
+  d.measured_mat = parse_measured_mat(n, "discover", ctx, dir);
   d.geometry = parse_geometry(n, "discover", ctx, dir);
   if (n["recordings"]) {
     const YAML::Node& r = n["recordings"];

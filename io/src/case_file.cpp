@@ -68,13 +68,15 @@ std::vector<MeasuredDof> parse_dof_selection(const YAML::Node& n, const YamlCtx&
 
 std::string parse_measured(const YAML::Node& n, const YamlCtx& ctx, const std::string& dir, const std::string& what) {
   if (!n.IsMap()) return resolve(dir, ctx.string(n, what));
-  ctx.only_keys(n, what, {"mat", "frequency_hz", "eigenvalues", "shapes", "dofs", "damping"});
+  ctx.only_keys(n, what, {"mat", "frequency_hz", "eigenvalues", "shapes", "dofs", "damping", "frequency_std", "eigenvalue_std",
+                          "shape_std"});
   if (!n["mat"]) ctx.fail(n, what + ": mat (the .mat file) is missing; give measured: FILE or {mat: FILE, shapes: VAR, ...}");
   if (n["frequency_hz"] && n["eigenvalues"]) ctx.fail(n, what + ": give frequency_hz or eigenvalues, not both");
+  if (n["frequency_std"] && n["eigenvalue_std"]) ctx.fail(n, what + ": give frequency_std or eigenvalue_std, not both");
   return resolve(dir, ctx.string(n["mat"], what + " mat"));
 }
 
-MatModalNames parse_measured_mat(const YAML::Node& section, const std::string& name, const YamlCtx& ctx) {
+MatModalNames parse_measured_mat(const YAML::Node& section, const std::string& name, const YamlCtx& ctx, const std::string& dir) {
   MatModalNames names;
   const YAML::Node m = section["measured"];
   if (!m || !m.IsMap()) return names;
@@ -84,8 +86,19 @@ MatModalNames parse_measured_mat(const YAML::Node& section, const std::string& n
   var("frequency_hz", &names.frequency_hz);
   var("eigenvalues", &names.eigenvalues);
   var("shapes", &names.shapes);
-  var("dofs", &names.dofs);
+  if (m["dofs"] && m["dofs"].IsMap()) {  // the DOFs from another .mat file (e.g. the model's)
+    const YAML::Node& d = m["dofs"];
+    ctx.only_keys(d, name + " measured dofs", {"mat", "var"});
+    if (!d["mat"] || !d["var"]) ctx.fail(d, name + " measured dofs: give {mat: FILE, var: VARIABLE} or a variable name");
+    names.dofs_file = resolve(dir, ctx.string(d["mat"], name + " measured dofs mat"));
+    names.dofs = ctx.string(d["var"], name + " measured dofs var (a variable name)");
+  } else {
+    var("dofs", &names.dofs);
+  }
   var("damping", &names.damping);
+  var("frequency_std", &names.frequency_std);
+  var("eigenvalue_std", &names.eigenvalue_std);
+  var("shape_std", &names.shape_std);
   return names;
 }
 
@@ -228,7 +241,7 @@ DetectSpec parse_detect(const YAML::Node& n, const YamlCtx& ctx, const Model& mo
     d.measured_dofs = n["measured_dofs"] ? parse_dof_selection(n["measured_dofs"], ctx, model, "measured_dofs") : all_dofs(model);
   } else {
     d.measured_file = parse_measured(n["measured"], ctx, dir, "detect measured");
-    d.measured_mat = parse_measured_mat(n, "detect", ctx);
+    d.measured_mat = parse_measured_mat(n, "detect", ctx, dir);
     if (n["measured_dofs"]) ctx.fail(n["measured_dofs"], "detect: measured_dofs is for simulations; measured data carry their own DOFs");
   }
   if (n["reference_measured"]) d.reference_measured_file = resolve(dir, ctx.string(n["reference_measured"], "reference_measured"));
@@ -383,6 +396,7 @@ ModalData first_modes(ModalData m, int count) {
   if (count <= 0 || count >= m.num_modes()) return m;
   m.frequencies_hz.conservativeResize(count);
   m.shapes.conservativeResize(Eigen::NoChange, count);
+  if (m.shape_entry_std.cols() > count) m.shape_entry_std.conservativeResize(Eigen::NoChange, count);
   // Every per-mode vector given (identified data carry damping, MPC and standard deviations) is cut alike.
   for (Eigen::VectorXd* v : {&m.damping_ratios, &m.mpc, &m.frequency_std_hz, &m.damping_std, &m.shape_std})
     if (v->size() > count) v->conservativeResize(count);

@@ -43,13 +43,13 @@ std::vector<int> element_list(const YAML::Node& n, const YamlCtx& ctx, const Mod
 UpdateSpec parse_update(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir) {
   ctx.require_map(n, "update");
   ctx.only_keys(n, "update", {"measured", "geometry", "target", "modes", "objective", "parameters", "noise", "regularization",
-                              "loss", "loss_scale", "solver", "max_iterations", "min_mac", "extra_modes"});
+                              "loss", "loss_scale", "solver", "max_iterations", "min_mac", "extra_modes", "multistart"});
   UpdateSpec u;
   FitOptions& o = u.options;
   if (n["measured"] && n["target"]) ctx.fail(n, "update: give either measured: (a file) or target: (a simulation), not both");
   if (!n["measured"] && !n["target"]) ctx.fail(n, "update: the measured data are missing: give measured: FILE or target: {...}");
   if (n["measured"]) u.measured_file = parse_measured(n["measured"], ctx, dir, "update measured");
-  u.measured_mat = parse_measured_mat(n, "update", ctx);
+  u.measured_mat = parse_measured_mat(n, "update", ctx, dir);
   u.geometry = internal::parse_geometry(n, "update", ctx, dir);
   if (n["target"]) {
     const YAML::Node& t = n["target"];
@@ -114,6 +114,24 @@ UpdateSpec parse_update(const YAML::Node& n, const YamlCtx& ctx, const Model& mo
   if (n["max_iterations"]) o.max_iterations = ctx.integer(n["max_iterations"], "max_iterations");
   if (n["min_mac"]) o.min_mac = ctx.number(n["min_mac"], "min_mac");
   if (n["extra_modes"]) o.extra_modes = ctx.integer(n["extra_modes"], "extra_modes");
+  if (n["multistart"]) {  // true | false | {starts: N, continuation: bool, seed: N}
+    const YAML::Node& q = n["multistart"];
+    if (q.IsScalar()) {
+      u.multistart = ctx.boolean(q, "multistart");
+    } else {
+      ctx.require_map(q, "multistart");
+      ctx.only_keys(q, "multistart", {"starts", "continuation", "seed"});
+      u.multistart = true;
+      if (q["starts"]) u.search.starts = ctx.integer(q["starts"], "multistart starts");
+      if (q["starts"] && u.search.starts < 2) ctx.fail(q["starts"], "multistart: starts must be >= 2 (leave it out for the rule)");
+      if (q["continuation"]) u.search.continuation = ctx.boolean(q["continuation"], "multistart continuation");
+      if (q["seed"]) {
+        const int seed = ctx.integer(q["seed"], "multistart seed");
+        if (seed < 0) ctx.fail(q["seed"], "multistart: seed must be >= 0");
+        u.search.seed = static_cast<std::uint64_t>(seed);
+      }
+    }
+  }
   std::string why;
   if (!o.IsValid(&why)) ctx.fail(n, "update: " + why);
 

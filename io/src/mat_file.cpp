@@ -422,7 +422,9 @@ MatrixModelData read_mat_matrix_model(const MatModelNames& n, std::vector<std::s
   // Size of the system: from the DOF table, else the first matrix.
   std::vector<SparseMatrix> group_K(n.groups.size()), group_M(n.groups.size());
   for (std::size_t g = 0; g < n.groups.size(); ++g) {
-    group_K[g] = f.sparse(n.groups[g].K, "stiffness of group '" + n.groups[g].name + "'");
+    if (n.groups[g].K.empty() && n.groups[g].M.empty())
+      throw InputError(n.file + ": group '" + n.groups[g].name + "' names neither a stiffness nor a mass variable");
+    if (!n.groups[g].K.empty()) group_K[g] = f.sparse(n.groups[g].K, "stiffness of group '" + n.groups[g].name + "'");
     if (!n.groups[g].M.empty()) group_M[g] = f.sparse(n.groups[g].M, "mass of group '" + n.groups[g].name + "'");
   }
   if (!n.K.empty()) {
@@ -439,7 +441,7 @@ MatrixModelData read_mat_matrix_model(const MatModelNames& n, std::vector<std::s
     d.dofs = dof_rows(f, n.dofs, "the DOF table: [node, dof 1..6] per equation");
     d.dofs_name = n.file + ": variable '" + n.dofs + "'";
   } else {
-    size = d.has_assembled ? d.K.rows() : !n.groups.empty() ? group_K[0].rows() : -1;
+    size = d.has_assembled ? d.K.rows() : !n.groups.empty() ? std::max(group_K[0].rows(), group_M[0].rows()) : -1;
     for (const Eigen::MatrixXd& q : element_eqs)
       if (q.size() > 0 && size < 0) size = 0;
     if (size == 0)
@@ -451,8 +453,7 @@ MatrixModelData read_mat_matrix_model(const MatModelNames& n, std::vector<std::s
     d.dofs_name = n.file + " (no DOF table: equation i is ux of node i)";
     if (notes)
       notes->push_back(n.file + ": no DOF table (dofs:): each of the " + std::to_string(size) +
-                       " equations is DOF ux of its own node (ids 1..n); without geometry, plots and geometric discovery "
-                       "candidates mean nothing");
+                       " equations is DOF ux of its own node (ids 1..n)");
   }
   if (!n.nodes.empty()) {
     const Eigen::MatrixXd N = f.matrix(n.nodes, "the node table: [id, x, y(, z)] per node");
@@ -468,16 +469,9 @@ MatrixModelData read_mat_matrix_model(const MatModelNames& n, std::vector<std::s
       d.nodes.push_back(nd);
     }
     d.nodes_name = n.file + ": variable '" + n.nodes + "'";
-  } else {
-    std::vector<int> ids;
-    for (const DofRow& r : d.dofs) ids.push_back(r.node);
-    std::sort(ids.begin(), ids.end());
-    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-    for (int id : ids) d.nodes.push_back(Node{id, Eigen::Vector3d::Zero()});
-    d.nodes_name = n.file + " (no node table: nodes at the origin)";
   }
   for (std::size_t g = 0; g < n.groups.size(); ++g)
-    d.groups.push_back({n.groups[g].name, n.file + ": variable '" + n.groups[g].K + "'",
+    d.groups.push_back({n.groups[g].name, n.groups[g].K.empty() ? "" : n.file + ": variable '" + n.groups[g].K + "'",
                         n.groups[g].M.empty() ? "" : n.file + ": variable '" + n.groups[g].M + "'", std::move(group_K[g]),
                         std::move(group_M[g])});
   if (!n.element_K.empty()) {
@@ -590,22 +584,55 @@ ModalData read_mat_modal_data(const MatModalNames& n) {
                      " for " + std::to_string(m.frequencies_hz.size()) + " modes; DOFs x modes is needed" +
                      (transposed ? " (it looks transposed)" : ""));
   }
-  bool text = false;
-  for (const MatFile::Info& i : f.variables())
-    if (i.name == n.dofs) text = i.type == "char" || i.type == "cell";
+  const std::unique_ptr<MatFile> other = n.dofs_file.empty() ? nullptr : std::make_unique<MatFile>(n.dofs_file);
+  const MatFile& fd = other ? *other : f;
+  bool text = false, vector = false;
+  for (const MatFile::Info& i : fd.variables())
+    if (i.name == n.dofs) {
+      text = i.type == "char" || i.type == "cell";
+      vector = !text && i.dims.size() == 2 && (i.dims[0] == 1 || i.dims[1] == 1) && i.dims[0] * i.dims[1] == static_cast<std::size_t>(m.shapes.rows());
+    }
   if (text) {
-    for (const std::string& l : f.strings(n.dofs, "DOF labels, one per shape row")) {
+    for (const std::string& l : fd.strings(n.dofs, "DOF labels, one per shape row")) {
       MeasuredDof d;
       double sign = 1;
-      if (!parse_dof_label(l, &d, &sign)) throw InputError(who(n.file, n.dofs, "DOF labels") + ": '" + l + "' is not a DOF label (e.g. 13uy)");
+      if (!parse_dof_label(l, &d, &sign)) throw InputError(who(fd.path(), n.dofs, "DOF labels") + ": '" + l + "' is not a DOF label (e.g. 13uy)");
       m.dofs.push_back(d);
     }
+  } else if (vector) {  // equation numbers of a matrix model without a DOF table
+    const Eigen::VectorXd q = fd.vector(n.dofs, "equation numbers (1-based) of the shape rows");
+    for (Eigen::Index i = 0; i < q.size(); ++i) {
+      if (q[i] != std::floor(q[i]) || q[i] < 1 || q[i] > 2e9)
+        throw InputError(who(fd.path(), n.dofs, "equation numbers") + ": entry " + std::to_string(i + 1) + " is " + int_text(q[i]) +
+                         "; 1-based equation numbers are needed");
+      m.dofs.push_back({static_cast<int>(q[i]), Dof::UX});
+    }
   } else {
-    for (const DofRow& r : dof_rows(f, n.dofs, "DOFs of the shape rows: [node, dof 1..6] or labels")) m.dofs.push_back({r.node, r.dof});
+    for (const DofRow& r : dof_rows(fd, n.dofs, "DOFs of the shape rows: [node, dof 1..6], labels, or equation numbers")) m.dofs.push_back({r.node, r.dof});
   }
   if (static_cast<Eigen::Index>(m.dofs.size()) != m.shapes.rows())
-    throw InputError(who(n.file, n.dofs, "DOFs") + " lists " + std::to_string(m.dofs.size()) + " DOFs for " +
+    throw InputError(who(fd.path(), n.dofs, "DOFs") + " lists " + std::to_string(m.dofs.size()) + " DOFs for " +
                      std::to_string(m.shapes.rows()) + " shape rows");
+  auto per_mode = [&](const std::string& var, const char* what) {
+    Eigen::VectorXd v = f.vector(var, what);
+    if (v.size() != m.frequencies_hz.size())
+      throw InputError(who(n.file, var, what) + " has " + std::to_string(v.size()) + " values for " + std::to_string(m.frequencies_hz.size()) + " modes");
+    return v;
+  };
+  if (!n.frequency_std.empty()) m.frequency_std_hz = per_mode(n.frequency_std, "frequency standard deviations (Hz)");
+  if (!n.eigenvalue_std.empty()) {  // lambda = (2 pi f)^2: std f = std lambda / (8 pi^2 f)
+    const Eigen::VectorXd s = per_mode(n.eigenvalue_std, "eigenvalue standard deviations ((rad/s)^2)");
+    m.frequency_std_hz = s.array() / (8.0 * M_PI * M_PI * m.frequencies_hz.array());
+  }
+  if (!n.shape_std.empty()) {
+    const Eigen::MatrixXd S = f.matrix(n.shape_std, "shape standard deviations: DOFs x modes, or one per mode");
+    if (S.rows() == m.shapes.rows() && S.cols() == m.shapes.cols()) m.shape_entry_std = S;
+    else if (S.size() == m.frequencies_hz.size() && (S.rows() == 1 || S.cols() == 1)) m.shape_std = S.reshaped();
+    else
+      throw InputError(who(n.file, n.shape_std, "shape standard deviations") + " is " + std::to_string(S.rows()) + " x " +
+                       std::to_string(S.cols()) + "; " + std::to_string(m.shapes.rows()) + " x " + std::to_string(m.shapes.cols()) +
+                       " (one per shape entry) or one per mode is needed");
+  }
   if (!n.damping.empty()) {
     m.damping_ratios = f.vector(n.damping, "damping ratios");
     if (m.damping_ratios.size() != m.frequencies_hz.size())

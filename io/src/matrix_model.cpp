@@ -215,20 +215,22 @@ std::vector<ElementMatrices> parse_element_matrices(const std::string& text, con
 
 void add_matrix_model(const MatrixModelFiles& files, Model* model, std::vector<std::string>* notes) {
   if (files.dofs.empty()) throw InputError("matrix model: the DOF table (dofs:) is required");
-  if (files.nodes.empty()) throw InputError("matrix model: the node table (nodes:) is required");
   if (files.elements.empty() && files.groups.empty())
     throw InputError("matrix model: give element matrices (elements:) or group matrices (groups:)");
   if (files.K.empty() != files.M.empty()) throw InputError("matrix model: give both K and M, or neither");
   MatrixModelData d;
   d.dofs = parse_dof_table(internal::read_file_bytes(files.dofs), files.dofs);
   d.dofs_name = files.dofs;
-  d.nodes = parse_node_table(internal::read_file_bytes(files.nodes), files.nodes);
-  d.nodes_name = files.nodes;
+  if (!files.nodes.empty()) {
+    d.nodes = parse_node_table(internal::read_file_bytes(files.nodes), files.nodes);
+    d.nodes_name = files.nodes;
+  }
   const int n = static_cast<int>(d.dofs.size());
   if (!files.elements.empty()) d.elements = parse_element_matrices(internal::read_file_bytes(files.elements), files.elements, n);
   for (const MatrixModelFiles::Group& g : files.groups) {
-    if (g.K.empty() || g.M.empty()) throw InputError("matrix model: group '" + g.name + "' needs both K and M files");
-    d.groups.push_back({g.name, g.K, g.M, read_matrix_market(g.K), read_matrix_market(g.M)});
+    if (g.K.empty() && g.M.empty()) throw InputError("matrix model: group '" + g.name + "' names neither a K nor an M file");
+    d.groups.push_back({g.name, g.K, g.M, g.K.empty() ? SparseMatrix() : read_matrix_market(g.K),
+                        g.M.empty() ? SparseMatrix() : read_matrix_market(g.M)});
   }
   if (!files.K.empty()) {
     d.has_assembled = true;
@@ -255,6 +257,15 @@ void add_matrix_model(const MatrixModelData& data, Model* model, std::vector<std
   }
   std::set<int> node_ids;
   for (const Node& nd : data.nodes) node_ids.insert(nd.id);
+  std::vector<Node> origin_nodes;  // no node table: every node the DOF table names, at the origin
+  if (data.nodes.empty()) {
+    for (const DofRow& r : dofs)
+      if (node_ids.insert(r.node).second) origin_nodes.push_back(Node{r.node, Eigen::Vector3d::Zero()});
+    if (notes)
+      notes->push_back("matrix model: no node table (nodes:): the " + std::to_string(origin_nodes.size()) +
+                       " nodes have no coordinates (placed at the origin); modal analysis, detection and updating work, "
+                       "but model plots, position mapping of test points and geometric discovery candidates are unavailable");
+  }
   for (std::size_t i = 0; i < dofs.size(); ++i)
     if (!node_ids.count(dofs[i].node))
       throw InputError(data.dofs_name + ": equation " + std::to_string(i + 1) + " is at node " + std::to_string(dofs[i].node) +
@@ -343,16 +354,22 @@ void add_matrix_model(const MatrixModelData& data, Model* model, std::vector<std
     SK.setFromTriplets(tk.begin(), tk.end());
     SM.setFromTriplets(tm.begin(), tm.end());
     SA.setFromTriplets(ta.begin(), ta.end());
-    // Relative to the entry and to the sum of absolute contributions: exporters print 10 to 17 digits.
+    // Relative to the entry, to the sum of absolute contributions, and to the largest entries of its row and
+    // column (sqrt(s_i s_j)): exporters print 10 to 17 digits, and an entry where large contributions cancel
+    // holds rounding of the row's scale, not of its own (SAP2000's influence matrices are full of such noise).
     constexpr double tol = 1e-9;
     auto difference = [&](const SparseMatrix& A, const SparseMatrix& S, double* worst) {
+      Eigen::VectorXd s = Eigen::VectorXd::Zero(n);
+      for (const SparseMatrix* X : {&A, &S})
+        for (int j = 0; j < n; ++j)
+          for (SparseMatrix::InnerIterator it(*X, j); it; ++it) s[j] = std::max(s[j], std::abs(it.value()));
       SparseMatrix R = (A - S).pruned();
       *worst = 0;
       for (int j = 0; j < n; ++j)
         for (SparseMatrix::InnerIterator it(R, j); it; ++it) {
-          const double bound = tol * (std::abs(A.coeff(it.row(), j)) + SA.coeff(it.row(), j));
-          if (std::abs(it.value()) <= bound) it.valueRef() = 0.0;
-          else *worst = std::max(*worst, std::abs(it.value()) / std::max(bound / tol, 1e-300));
+          const double scale = std::abs(A.coeff(it.row(), j)) + SA.coeff(it.row(), j) + std::sqrt(s[it.row()] * s[j]);
+          if (std::abs(it.value()) <= tol * scale) it.valueRef() = 0.0;
+          else *worst = std::max(*worst, std::abs(it.value()) / std::max(scale, 1e-300));
         }
       R.prune(0.0);
       return R;
@@ -370,7 +387,7 @@ void add_matrix_model(const MatrixModelData& data, Model* model, std::vector<std
     }
   }
 
-  for (const Node& nd : data.nodes) model->add_node(nd.id, nd.x);
+  for (const Node& nd : data.nodes.empty() ? origin_nodes : data.nodes) model->add_node(nd.id, nd.x);
   for (ElementMatrices& e : elems) {
     MatrixElementData d;
     for (int q : e.equations) d.dofs.emplace_back(dofs[q].node, dofs[q].dof);

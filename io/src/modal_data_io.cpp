@@ -101,6 +101,29 @@ ModalData parse_modal_data_json(const std::string& text, const std::string& name
   optional("frequency_std_hz", &d.frequency_std_hz);
   optional("damping_std", &d.damping_std);
   optional("shape_std", &d.shape_std);
+  // Per-entry shape standard deviations: "shape_std" as an object {dof: std} like "shape" (every mode, every DOF).
+  for (std::size_t k = 0; k < modes.size(); ++k) {
+    const auto& m = modes[k];
+    if (!m.contains("shape_std") || !m["shape_std"].is_object()) {
+      if (k > 0 && d.shape_entry_std.size() != 0)
+        throw InputError(name + ": mode " + std::to_string(k + 1) + ": \"shape_std\" must be an object {dof: std} as in mode 1");
+      if (k == 0) break;
+      continue;
+    }
+    if (k == 0) d.shape_entry_std.resize(d.shapes.rows(), d.shapes.cols());
+    const auto& sd = m["shape_std"];
+    const std::string who = name + ": mode " + std::to_string(k + 1) + " shape_std";
+    if (sd.size() != d.dofs.size())
+      throw InputError(who + ": has " + std::to_string(sd.size()) + " DOFs, the shape " + std::to_string(d.dofs.size()) + " (one std per shape entry)");
+    std::size_t r = 0;
+    for (auto it = sd.begin(); it != sd.end(); ++it, ++r) {
+      MeasuredDof md;
+      if (!parse_dof_label(it.key(), &md, nullptr) || !(md == d.dofs[r]))
+        throw InputError(who + ": DOF \"" + it.key() + "\" differs from the shape's DOFs (same DOFs, same order)");
+      if (!it.value().is_number()) throw InputError(who + ": value of \"" + it.key() + "\" is not a number");
+      d.shape_entry_std(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(k)) = it.value().get<double>();
+    }
+  }
   d.validate(name);
   return d;
 }
@@ -118,6 +141,11 @@ nlohmann::ordered_json modal_data_json(const ModalData& d) {
     if (d.frequency_std_hz.size() == d.frequencies_hz.size()) m["frequency_std_hz"] = d.frequency_std_hz[k];
     if (d.damping_std.size() == d.frequencies_hz.size()) m["damping_std"] = d.damping_std[k];
     if (d.shape_std.size() == d.frequencies_hz.size()) m["shape_std"] = d.shape_std[k];
+    if (d.shape_entry_std.cols() == d.frequencies_hz.size() && d.shape_entry_std.rows() == d.shapes.rows()) {
+      nlohmann::ordered_json sd = nlohmann::ordered_json::object();
+      for (std::size_t r = 0; r < d.dofs.size(); ++r) sd[to_string(d.dofs[r])] = d.shape_entry_std(static_cast<Eigen::Index>(r), k);
+      m["shape_std"] = sd;  // per entry (replaces the per-mode value)
+    }
     if (d.mpc.size() == d.frequencies_hz.size()) m["mpc"] = d.mpc[k];
     nlohmann::ordered_json sh = nlohmann::ordered_json::object();
     for (std::size_t r = 0; r < d.dofs.size(); ++r) sh[to_string(d.dofs[r])] = d.shapes(static_cast<Eigen::Index>(r), k);

@@ -364,8 +364,9 @@ struct Parser {
           } else {
             ctx.require_map(kv.second, w);
             ctx.only_keys(kv.second, w, {"K", "M"});
-            if (!kv.second["K"]) fail(kv.second, w + ": K (a variable name) is missing");
-            n.groups.push_back({name, var(kv.second["K"], w + " K"), kv.second["M"] ? var(kv.second["M"], w + " M") : ""});
+            if (!kv.second["K"] && !kv.second["M"]) fail(kv.second, w + ": give K, M or both (variable names)");
+            n.groups.push_back({name, kv.second["K"] ? var(kv.second["K"], w + " K") : "",
+                                kv.second["M"] ? var(kv.second["M"], w + " M") : ""});
           }
         }
       }
@@ -388,9 +389,7 @@ struct Parser {
     ctx.require_map(m, "model matrices");
     if (m["mat"]) return read_mat_matrices(m);
     ctx.only_keys(m, "model matrices", {"dofs", "nodes", "elements", "groups", "K", "M"});
-    for (const char* k : {"dofs", "nodes"})
-      if (!m[k]) fail(m, std::string("model matrices: '") + k + "' is missing (" +
-                             (k[0] == 'd' ? "the DOF table: one line 'node, dof' per equation" : "the node table: 'id, x, y, z'") + ")");
+    if (!m["dofs"]) fail(m, "model matrices: 'dofs' is missing (the DOF table: one line 'node, dof' per equation)");
     if (!m["elements"] && !m["groups"]) fail(m, "model matrices: give 'elements' (element matrices) or 'groups' (group matrices)");
     if (!m["K"] != !m["M"]) fail(m, "model matrices: give both K and M (the assembled matrices), or neither");
     MatrixModelFiles f;
@@ -401,7 +400,7 @@ struct Parser {
       return path;
     };
     f.dofs = file(m["dofs"], "matrices dofs");
-    f.nodes = file(m["nodes"], "matrices nodes");
+    if (m["nodes"]) f.nodes = file(m["nodes"], "matrices nodes");
     if (m["elements"]) f.elements = file(m["elements"], "matrices elements");
     if (m["K"]) {
       f.K = file(m["K"], "matrices K");
@@ -413,8 +412,9 @@ struct Parser {
         const std::string name = kv.first.Scalar(), w = "matrices group '" + name + "'";
         ctx.require_map(kv.second, w);
         ctx.only_keys(kv.second, w, {"K", "M"});
-        if (!kv.second["K"] || !kv.second["M"]) fail(kv.second, w + ": needs K and M (Matrix Market files)");
-        f.groups.push_back({name, file(kv.second["K"], w + " K"), file(kv.second["M"], w + " M")});
+        if (!kv.second["K"] && !kv.second["M"]) fail(kv.second, w + ": give K, M or both (Matrix Market files)");
+        f.groups.push_back({name, kv.second["K"] ? file(kv.second["K"], w + " K") : "",
+                            kv.second["M"] ? file(kv.second["M"], w + " M") : ""});
       }
     }
     add_matrix_model(f, &model, notes);

@@ -31,6 +31,10 @@ std::map<int, int> map_test_points(const Model& model, const UffFile& geometry, 
   if (model.nodes().empty()) throw InputError(src + ": the model has no nodes to map the test points to");
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (const Node& n : model.nodes()) lo = lo.cwiseMin(n.x), hi = hi.cwiseMax(n.x);
+  if (spec.by_position && model.nodes().size() > 1 && (hi - lo).maxCoeff() == 0)
+    throw InputError(src + ": test points cannot be matched by position: the model's nodes have no coordinates (all at one "
+                     "point; a matrix model without a node table); give the model a node table, or match by id "
+                     "(geometry: match: id)");
   const double tol = spec.tolerance > 0 ? spec.tolerance : 0.01 * std::max((hi - lo).maxCoeff(), 1e-300);
   const std::string hint = length != 1.0 ? " (coordinates scaled by the file's length factor " + fmt(length) + " to metres)" : "";
 

@@ -64,18 +64,27 @@ nlohmann::json detect_json(const std::string& case_name, const DetectSummary& S)
   return j;
 }
 
-UpdateRun update_case(const Case& c) {
+UpdateRun update_case(const Case& c, const ModalData* measured) {
   require_section(c, c.update.has_value(), "update");
   const UpdateSpec& u = *c.update;
   UpdateRun run;
-  run.measured = update_measured_data(c);
+  run.measured = measured ? first_modes(*measured, u.modes) : update_measured_data(c);
   run.pm = std::make_unique<ParametricModel>(c.model);
   for (const Parameter& p : u.parameters) run.pm->add(p);
-  run.fit = fit_parameters(*run.pm, run.measured, u.initial, u.free, u.options);
+  const MeasuredNoise noise = measured_noise(run.measured, u.options);
+  if (u.multistart) {
+    run.search = fit_multistart(*run.pm, run.measured, u.initial, u.free, noise.options, u.search);
+    run.fit = run.search->best;
+    run.fit.warnings.insert(run.fit.warnings.begin(), run.search->warnings.begin(), run.search->warnings.end());
+  } else {
+    run.fit = fit_parameters(*run.pm, run.measured, u.initial, u.free, noise.options);
+  }
+  run.fit.warnings.insert(run.fit.warnings.begin(), noise.warnings.begin(), noise.warnings.end());
   return run;
 }
 
-nlohmann::json update_json(const std::string& case_name, const ParametricModel& pm, const UpdateSpec& u, const FitSummary& f) {
+nlohmann::json update_json(const std::string& case_name, const ParametricModel& pm, const UpdateSpec& u, const FitSummary& f,
+                           const MultiStartSummary* search) {
   nlohmann::json params = nlohmann::json::array();
   for (int p = 0; p < pm.num_parameters(); ++p) {
     const Parameter& q = pm.parameter(p);
@@ -104,6 +113,23 @@ nlohmann::json update_json(const std::string& case_name, const ParametricModel& 
   j["converged"] = f.converged;
   j["covariance"] = {{"rank", f.covariance_rank}, {"free_parameters", f.free_parameters}, {"full_rank", f.covariance_ok},
                      {"residual_scale", num(f.residual_scale)}};
+  if (search) {
+    const MultiStartSummary& s = *search;
+    nlohmann::json minima = nlohmann::json::array();
+    for (const LocalMinimum& m : s.minima) {
+      nlohmann::json th = nlohmann::json::object();
+      for (int p = 0; p < pm.num_parameters(); ++p) th[pm.parameter(p).name] = m.theta[p];
+      minima.push_back({{"cost", m.cost}, {"starts", m.starts}, {"parameters", th}, {"frequencies_hz", vec(m.final_hz)},
+                        {"mac", vec(m.final_mac)}, {"max_frequency_error", m.max_frequency_error}, {"mean_mac", m.mean_mac},
+                        {"at_bound", m.at_bound}, {"converged", m.converged}});
+    }
+    nlohmann::json costs = nlohmann::json::array();
+    for (double c : s.start_cost) costs.push_back(num(std::isfinite(c) ? c : std::nan("")));
+    j["multistart"] = {{"starts", s.start_points.size()}, {"seed", u.search.seed}, {"continuation", u.search.continuation},
+                       {"same_minimum", u.search.same_minimum}, {"failed", s.failed}, {"best_start", s.best_start},
+                       {"distinct_minima", s.minima.size()}, {"minima", minima}, {"start_costs", costs},
+                       {"time_wall_s", s.time_wall}, {"time_cpu_s", s.time_cpu}};
+  }
   j["warnings"] = f.warnings;
   return j;
 }

@@ -328,18 +328,13 @@ void bind_analysis(py::module_& mod) {
   mod.def("_update", [](std::shared_ptr<Case> c, py::object measured) {
     if (!c->update) throw InputError(c->path + ": the case has no update: section (see docs/case-file.md)");
     UpdateRun run;
-    if (measured.is_none()) {
+    std::optional<ModalData> data;
+    if (!measured.is_none()) data = to_modal_data(measured, "update measured");
+    {
       GilRelease nogil;
-      run = update_case(*c);
-    } else {
-      const UpdateSpec& u = *c->update;
-      run.measured = first_modes(to_modal_data(measured, "update measured"), u.modes);
-      GilRelease nogil;
-      run.pm = std::make_unique<ParametricModel>(c->model);
-      for (const Parameter& p : u.parameters) run.pm->add(p);
-      run.fit = fit_parameters(*run.pm, run.measured, u.initial, u.free, u.options);
+      run = update_case(*c, data ? &*data : nullptr);
     }
-    py::dict d = to_python(update_json(c->name, *run.pm, *c->update, run.fit)).cast<py::dict>();
+    py::dict d = to_python(update_json(c->name, *run.pm, *c->update, run.fit, run.search ? &*run.search : nullptr)).cast<py::dict>();
     d["theta"] = move_array(Eigen::VectorXd(run.fit.theta));
     return d;
   });

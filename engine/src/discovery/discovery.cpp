@@ -98,6 +98,7 @@ void check_set_aside(const Problem& p, const ModalData& measured, const SetFit& 
     d.shapes.col(static_cast<Eigen::Index>(k)) = measured.shapes.col(idx[k]);
   }
   d.damping_ratios.resize(0), d.mpc.resize(0), d.frequency_std_hz.resize(0), d.damping_std.resize(0), d.shape_std.resize(0);
+  d.shape_entry_std.resize(0, 0);
   ParametricModel pm(*p.model);
   const std::vector<int> first = install_candidates(&pm, f.set);
   Eigen::VectorXd th = pm.nominal();

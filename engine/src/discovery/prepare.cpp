@@ -39,6 +39,10 @@ ModalData select_modes(const ModalData& d, const std::vector<int>& keep) {
   pick(d.frequency_std_hz, &o.frequency_std_hz);
   pick(d.damping_std, &o.damping_std);
   pick(d.shape_std, &o.shape_std);
+  if (d.shape_entry_std.cols() == d.frequencies_hz.size() && d.shape_entry_std.size() > 0) {
+    o.shape_entry_std.resize(d.shapes.rows(), n);
+    for (Eigen::Index j = 0; j < n; ++j) o.shape_entry_std.col(j) = d.shape_entry_std.col(keep[static_cast<std::size_t>(j)]);
+  }
   return o;
 }
 

@@ -20,9 +20,10 @@ std::string resolve(const std::string& dir, const std::string& file);
 /// tolerance: T}, only beside measured:. None given: an empty GeometrySpec.
 GeometrySpec parse_geometry(const YAML::Node& section, const std::string& name, const YamlCtx& ctx, const std::string& dir);
 /// The `measured:` file of a section: FILE, or {mat: FILE, frequency_hz | eigenvalues: VAR, shapes: VAR, dofs: VAR,
-/// damping: VAR} (a MATLAB file, whose variable names parse_measured_mat() returns).
+/// damping: VAR, frequency_std | eigenvalue_std: VAR, shape_std: VAR} (a MATLAB file, whose variable names
+/// parse_measured_mat() returns; dofs: {mat: FILE, var: VAR} takes the DOFs from another file, resolved against `dir`).
 std::string parse_measured(const YAML::Node& n, const YamlCtx& ctx, const std::string& dir, const std::string& what);
-MatModalNames parse_measured_mat(const YAML::Node& section, const std::string& name, const YamlCtx& ctx);
+MatModalNames parse_measured_mat(const YAML::Node& section, const std::string& name, const YamlCtx& ctx, const std::string& dir);
 
 }  // namespace dynid::internal
 

@@ -29,6 +29,9 @@ struct ModalData {
   Eigen::VectorXd damping_std;       ///< optional standard deviation of each damping ratio
   /// Optional standard deviation of each mode's shape entries, relative to the mode's largest entry.
   Eigen::VectorXd shape_std;
+  /// Optional standard deviation of every shape entry (dofs x modes, in the units of `shapes`). An entry with
+  /// std 0 is exact: the entry each mode was normalised by (its value fixes the mode's scale).
+  Eigen::MatrixXd shape_entry_std;
   std::string source;              ///< where it came from (file, "simulation of ...")
   int num_modes() const { return static_cast<int>(frequencies_hz.size()); }
   /// Throws InputError if sizes disagree or values are not finite / frequencies not positive.

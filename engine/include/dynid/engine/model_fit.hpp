@@ -32,6 +32,11 @@ struct FitOptions {
   /// Per measured mode, when given (one value per mode): they replace frequency_noise and shape_noise for that
   /// mode (measured uncertainties differ from mode to mode).
   Eigen::VectorXd frequency_noise_modes, shape_noise_modes;
+  /// Per shape entry, when given (measured DOFs x modes): the std of each entry relative to its mode's largest
+  /// entry; replaces the per-mode shape noise in `combined` (f2 uses each mode's RMS). An entry of 0 is exact
+  /// (the entry the mode was normalised by): the model shape is scaled to match the exact entries, which carry
+  /// no residual.
+  Eigen::MatrixXd shape_noise_entries;
   double regularization = 0.0;    ///< Tikhonov weight w: residuals sqrt(w) (theta_p - nominal_p) / scale_p
   enum class Loss { kNone, kHuber, kCauchy };
   Loss loss = Loss::kNone;        ///< robust loss on each mode's frequency residual and, separately, its shape
@@ -91,6 +96,17 @@ struct FitSummary {
   std::vector<std::string> warnings;
   std::string report;           ///< Ceres FullReport()
 };
+
+/// The noise a fit should weight by when the measured data carry their own standard deviations: `options` with
+/// frequency_noise_modes from ModalData::frequency_std_hz (relative), and shape_noise_entries from
+/// shape_entry_std (relative to each mode's largest entry) or shape_noise_modes from shape_std. What the data do
+/// not carry stays at the stated levels, and a warning says so.
+struct MeasuredNoise {
+  FitOptions options;
+  bool frequency = false, shape = false;  ///< taken from the data
+  std::vector<std::string> warnings;
+};
+MeasuredNoise measured_noise(const ModalData& measured, const FitOptions& options);
 
 /// Fits the parameters marked free (all if `free` is empty) starting from theta0. Throws InputError on
 /// invalid options or data that does not match the model.

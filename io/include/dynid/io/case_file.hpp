@@ -14,6 +14,7 @@
 #include "dynid/engine/identify.hpp"
 #include "dynid/engine/virtual_test.hpp"
 #include "dynid/engine/model_fit.hpp"
+#include "dynid/engine/multistart.hpp"
 #include "dynid/io/mat_file.hpp"
 #include "dynid/io/point_map.hpp"
 #include "dynid/engine/parametric.hpp"
@@ -61,6 +62,8 @@ struct UpdateSpec {
   std::vector<char> free;
   std::vector<std::pair<int, std::pair<int, double>>> ties;
   FitOptions options;
+  bool multistart = false;               ///< global search (multistart:), with:
+  MultiStartOptions search;
 };
 
 /// What `test:` asks for (docs/case-file.md): a virtual test of the case's model (`dynid simulate-test`), the

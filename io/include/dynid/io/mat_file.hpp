@@ -102,8 +102,14 @@ struct MatModalNames {
   std::string frequency_hz = "frequency_hz";
   std::string eigenvalues;            ///< instead of frequency_hz: lambda = omega^2
   std::string shapes = "shapes";
-  std::string dofs = "dofs";          ///< DOF labels (text) or n x 2 [node, dof 1..6]
+  std::string dofs = "dofs";          ///< DOF labels (text), n x 2 [node, dof 1..6], or a vector of equation
+                                      ///< numbers of a matrix model without a DOF table (equation q = ux of node q)
+  std::string dofs_file;              ///< the file holding `dofs` when not `file` (e.g. the model's .mat)
   std::string damping;                ///< optional damping ratios
+  std::string frequency_std;          ///< optional std of each frequency (Hz)
+  std::string eigenvalue_std;         ///< optional std of each eigenvalue ((rad/s)^2), instead of frequency_std
+  std::string shape_std;              ///< optional std of each shape entry (DOFs x modes, units of `shapes`; 0 =
+                                      ///< exact, the normalising entry), or one per mode (relative to its largest)
 };
 ModalData read_mat_modal_data(const MatModalNames& names);
 

@@ -16,10 +16,11 @@ namespace dynid {
 /// The files of a matrix model. Paths as given (the case reader resolves them against the case folder).
 struct MatrixModelFiles {
   std::string dofs;      ///< DOF table: row i = equation i: "node, dof" (dof: ux..rz or 1..6)   (required)
-  std::string nodes;     ///< node table: "id, x, y, z"                                           (required)
+  std::string nodes;     ///< node table: "id, x, y, z" (optional: without it the nodes have no coordinates)
   std::string elements;  ///< element matrices (the "%%dynid element-matrices" format)
   struct Group {
-    std::string name, K, M;  ///< a group's stiffness and mass matrices on the global equations (Matrix Market)
+    std::string name, K, M;  ///< a group's stiffness and mass matrices on the global equations (Matrix Market);
+                             ///< one of them may be empty (a stiffness-only or mass-only group)
   };
   std::vector<Group> groups;  ///< group matrices, each one Matrix element (in addition to `elements`)
   std::string K, M;  ///< assembled matrices (Matrix Market), optional: checked against the sum of the elements;
@@ -58,7 +59,7 @@ std::vector<ElementMatrices> parse_element_matrices(const std::string& text, con
 struct MatrixModelData {
   std::vector<DofRow> dofs;     ///< equation i -> (node, DOF type)  (required)
   std::string dofs_name = "the DOF table";
-  std::vector<Node> nodes;      ///< every node a DOF names (required)
+  std::vector<Node> nodes;      ///< every node a DOF names (empty: nodes at the origin, without coordinates)
   std::string nodes_name = "the node table";
   std::vector<ElementMatrices> elements;  ///< element matrices on 0-based equations
   struct Group {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -28,15 +29,20 @@ nlohmann::json detect_json(const std::string& case_name, const DetectSummary& s)
 struct UpdateRun {
   ModalData measured;
   std::unique_ptr<ParametricModel> pm;
-  FitSummary fit;
+  FitSummary fit;                        ///< the fit (with multistart: the best start's)
+  std::optional<MultiStartSummary> search;  ///< the global search, when the case asks for it
 };
-UpdateRun update_case(const Case& c);
+/// `measured`, when given, replaces the case's measured data (a host's own modes; the first update: modes used).
+UpdateRun update_case(const Case& c, const ModalData* measured = nullptr);
 
 /// The update results JSON: {"case", "parameters", "frequencies_hz", "mac", "objective", "iterations",
 /// "model_evaluations", "cost", "termination", "converged", "covariance", "warnings"}. `u` gives the initial
-/// values, which parameters are free, the ties and the objective.
+/// values, which parameters are free, the ties and the objective. With `search` (multistart), also "multistart":
+/// {"starts", "seed", "continuation", "same_minimum", "failed", "best_start", "distinct_minima", "minima" (lowest
+/// cost first: cost, starts, parameters, frequencies_hz, mac, max_frequency_error, mean_mac, at_bound, converged),
+/// "start_costs", "time_wall_s", "time_cpu_s"}.
 nlohmann::json update_json(const std::string& case_name, const ParametricModel& pm, const UpdateSpec& u,
-                           const FitSummary& f);
+                           const FitSummary& f, const MultiStartSummary* search = nullptr);
 
 /// The measured modes of a discover: case given in memory instead of the case's measured: / recordings: (host
 /// codes, Python): modal data, kept as discovery_data() keeps a file's (min_mpc, modes), or recordings,
