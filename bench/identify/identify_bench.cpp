@@ -10,7 +10,8 @@
 // come from dynid's simulate_test (exact modal superposition), noise added here so that its level is known.
 // They are written as UFF 58b twice, one file per test and one file per channel, read back through
 // read_test_set and identified with identify_recordings' defaults (no band, no orders: the band rule of
-// plan_identification from the spectral peaks), LSCF for impact and random tests, SSI for ambient ones.
+// plan_identification from the spectral peaks) and identify_recordings' choice of method (the tables' "method"
+// rows: LSCF for impacts, SSI for continuous records).
 //
 // Scoring (fixed with the seeds, before any tuning):
 //   in-band modes   truth modes below the band top whose peak response stands >= 10 dB above the sensor noise
@@ -150,7 +151,7 @@ bool draw(std::uint64_t seed, Case* c) {
   const int ex = integer(r, 0, 2);
   o.excitation = ex == 0 ? Excitation::kImpact : ex == 1 ? Excitation::kRandom : Excitation::kAmbient;
   c->excitation = ex == 0 ? "impact" : ex == 1 ? "random" : "ambient";
-  c->method = ex == 2 ? "ssi" : "lscf";
+  c->method = ex == 2 ? "ssi" : "lscf";  // what the data allow (the method rows use identify_recordings' choice)
   o.damping_ratio = log_uniform(r, 0.005, 0.05);
   o.noise = uniform(r, 0.005, 0.05);
   o.force_noise = o.noise;
@@ -227,6 +228,7 @@ struct Score {
   std::string error;  // identification failed
   std::vector<std::string> missed, spurious_list;
   double band_lo = 0, band_hi = 0;  // the band analysed
+  std::string method;               // the method identify_recordings chose
   std::vector<std::string> modes;   // every reported mode with its evidence (--verbose)
 };
 
@@ -252,6 +254,7 @@ Score score(const Case& c, const ModalData& truth, const std::vector<double>& sn
   const int nt = truth.num_modes(), nr = static_cast<int>(s.modes.size());
   sc.reported = nr;
   sc.band_lo = s.band_lo_hz, sc.band_hi = s.band_hi_hz;
+  sc.method = s.method;
   auto mac = [&](int r, int t) { return shape_mac(s.modes[static_cast<std::size_t>(r)].real_shape, truth.shapes.col(t)); };
   // Found: one to one, best MAC first, within 0.5 % and MAC >= 0.9.
   std::vector<char> expected(static_cast<std::size_t>(nt), 0);
@@ -458,7 +461,7 @@ int main(int argc, char** argv) {
       }
       all[layout].add(sc[layout]);
       const std::string lay = layout ? "one file per channel" : "one file per test";
-      by_key["method " + c.method + " / " + lay].add(sc[layout]);
+      by_key["method " + (sc[layout].method.empty() ? c.method : sc[layout].method) + " / " + lay].add(sc[layout]);
       if (layout == 0) {
         by_key["excitation " + c.excitation].add(sc[layout]);
         by_key["structure " + c.structure].add(sc[layout]);
