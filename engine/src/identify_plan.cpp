@@ -159,8 +159,10 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
     // Impacts: the outputs' energy over the hits' (a sum of |FRF|^2): the peaks of every mode the hits excite,
     // not only of those below the hits' spectral roll-off.
     const Spectrum in = channel_spectrum(recs, true, segment, true);
-    if (in.level.size() == sp.level.size())
-      for (Eigen::Index k = 0; k < sp.level.size(); ++k) sp.level[k] /= std::max(in.level[k], 1e-300 + 1e-12 * in.level.maxCoeff());
+    if (in.level.size() == sp.level.size()) {
+      const double tiny = std::max(1e-12 * in.level.maxCoeff(), 1e-300);  // lines the hits do not reach
+      for (Eigen::Index k = 0; k < sp.level.size(); ++k) sp.level[k] /= std::max(in.level[k], tiny);
+    }
   }
   if (sp.level.size() < 8) {
     p.notes.push_back("records too short for a spectrum: the band and resolution are left as given");

@@ -213,8 +213,8 @@ ModelBand band_from_model(const Model& model, const std::vector<MeasuredDof>& se
 /// recording per hit location) or "ssi" (the output channels; records of all recordings concatenated); "" picks
 /// by the data: lscf for impacts (every force record a blow), ssi for continuous records, output-only or with a
 /// random force (broadband: the outputs alone identify the modes, free of the leakage bias Welch FRFs have at
-/// the lowest modes of a wide band). The band and resolution come from plan_identification where the options leave them open; then the
-/// split-data uncertainty (header comment) when options.split_uncertainty.
+/// the lowest modes of a wide band). The band and resolution come from plan_identification where the options
+/// leave them open; then the split-data uncertainty (header comment) when options.split_uncertainty.
 IdentificationSummary identify_recordings(std::vector<Recording> recordings, const std::string& method,
                                           const IdentificationOptions& options);
 /// FRFs identified with LSCF (the band from plan_identification where the options leave it open), with the
