@@ -99,7 +99,10 @@ void print_rejected(const IdentificationSummary& s) {
       case Rejection::kFewOrders: why = fmt::format("stable over {:.0f} % of the orders (< {:.0f} %)", 100 * r.value, 100 * r.limit); break;
       case Rejection::kComplexShape: why = fmt::format("complex shape, MPC {:.2f} < {:.2f}: noise or a mathematical pole", r.value, r.limit); break;
       case Rejection::kIndicatorTrough:
-        why = fmt::format("the mode indicator sits {:.1f} dB below its surroundings (a trough, not a peak)", -r.value);
+        why = fmt::format("the mode indicator stands {:+.1f} dB above its surroundings (< {:.1f} dB): no peak", r.value, r.limit);
+        break;
+      case Rejection::kSpectralEdge:
+        why = fmt::format("the mode indicator falls {:.1f} dB faster than a resonance beside it: a spectral edge (excitation or filter)", r.value);
         break;
       case Rejection::kSplit: why = fmt::format("a split of mode {} (same shape, MAC {:.3f}): merged into it", r.merged_into + 1, r.value); break;
     }
@@ -143,10 +146,10 @@ int run_identify(const IdentifyArgs& a, const GlobalOptions& g) {
     const std::vector<Recording> recs = set.recordings();
     bool has_inputs = false;
     for (const Recording& r : recs) has_inputs = has_inputs || !r.input_channels().empty();
-    if (method.empty()) method = has_inputs ? "lscf" : "ssi";
     if (method == "lscf" && !has_inputs) throw InputError("identify: LSCF needs FRFs or recordings with a force channel; these are output-only: use --method ssi");
-    progress.update("identifying (" + method + ")", -1);
-    s = identify_recordings(recs, method, io);
+    progress.update("identifying" + (method.empty() ? std::string() : " (" + method + ")"), -1);
+    s = identify_recordings(recs, method, io);  // no method given: the engine's rule (impacts lscf, else ssi)
+    method = s.method;
   }
   progress.done();
 
@@ -279,7 +282,7 @@ void register_identify(CLI::App& app, GlobalOptions& g) {
                   "re/im columns, spectra: recognised by content), LabVIEW .lvm")
       ->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("--method", a->method, "lscf or ssi (default: lscf when there are FRFs or a force channel, else ssi)")
+  cmd->add_option("--method", a->method, "lscf or ssi (default: lscf for FRFs and impacts, ssi for continuous records)")
       ->check(CLI::IsMember({"lscf", "ssi"}));
   cmd->add_option("--band", a->band, "Analysis band LO HI in Hz (default: from the spectral peaks, 0.5 x the lowest to 1.25 x the highest)")->expected(2);
   cmd->add_option("--orders", a->orders, "Model orders MIN MAX")->expected(2);

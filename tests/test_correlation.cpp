@@ -44,6 +44,22 @@ TEST(Correlation, PairingBreaksMacTiesByFrequency) {
   EXPECT_EQ(p.pairs[0].b, 1);
 }
 
+TEST(Correlation, PairingRefusesPartnersMoreThanTwiceApart) {
+  // Issue 16, item 5: a measured mode whose only similar model mode is 2.5x its frequency stays unpaired (a
+  // spurious mode or a spatial alias), however high the MAC; one 1.9x away is still a partner (the bound is 2x).
+  Eigen::MatrixXd mac(2, 2);
+  mac << 0.99, 0.1,
+         0.1, 0.95;
+  const Pairing p = pair_modes(mac, Eigen::Vector2d(10, 40), Eigen::Vector2d(25, 76));
+  ASSERT_EQ(p.pairs.size(), 1u);
+  EXPECT_EQ(p.pairs[0].a, 1);
+  EXPECT_EQ(p.pairs[0].b, 1);
+  EXPECT_EQ(p.unpaired_a, std::vector<int>{0});
+  // A tighter bound given by the caller wins; without frequencies there is no bound.
+  EXPECT_TRUE(pair_modes(mac, Eigen::Vector2d(10, 40), Eigen::Vector2d(25, 76), 0.5, 1.5).pairs.empty());
+  EXPECT_EQ(pair_modes(mac, Eigen::VectorXd(), Eigen::VectorXd()).pairs.size(), 2u);
+}
+
 TEST(Serep, ReducedModelReproducesTheModes) {
   // Paper beam, masters = the 11 translations, 11 modes: K~, M~ reproduce the 11 eigenvalues (dense
   // generalized eigen-solve of the reduced pair, 1e-9 relative) and T expands the modes exactly.

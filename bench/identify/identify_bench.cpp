@@ -10,7 +10,8 @@
 // come from dynid's simulate_test (exact modal superposition), noise added here so that its level is known.
 // They are written as UFF 58b twice, one file per test and one file per channel, read back through
 // read_test_set and identified with identify_recordings' defaults (no band, no orders: the band rule of
-// plan_identification from the spectral peaks), LSCF for impact and random tests, SSI for ambient ones.
+// plan_identification from the spectral peaks) and identify_recordings' choice of method (the tables' "method"
+// rows: LSCF for impacts, SSI for continuous records).
 //
 // Scoring (fixed with the seeds, before any tuning):
 //   in-band modes   truth modes below the band top whose peak response stands >= 10 dB above the sensor noise
@@ -150,7 +151,7 @@ bool draw(std::uint64_t seed, Case* c) {
   const int ex = integer(r, 0, 2);
   o.excitation = ex == 0 ? Excitation::kImpact : ex == 1 ? Excitation::kRandom : Excitation::kAmbient;
   c->excitation = ex == 0 ? "impact" : ex == 1 ? "random" : "ambient";
-  c->method = ex == 2 ? "ssi" : "lscf";
+  c->method = ex == 2 ? "ssi" : "lscf";  // what the data allow (the method rows use identify_recordings' choice)
   o.damping_ratio = log_uniform(r, 0.005, 0.05);
   o.noise = uniform(r, 0.005, 0.05);
   o.force_noise = o.noise;
@@ -226,12 +227,34 @@ struct Score {
   double seconds = 0;
   std::string error;  // identification failed
   std::vector<std::string> missed, spurious_list;
+  double band_lo = 0, band_hi = 0;  // the band analysed
+  std::string method;               // the method identify_recordings chose
+  std::vector<std::string> modes;   // every reported mode with its evidence (--verbose)
 };
+
+// The mode indicator (dB) of a summary at f, interpolated; the levels either side at f -+ max(2 zeta f, 2 df)
+// relative to the mode's own level, for the log.
+std::pair<double, double> side_drops(const IdentificationSummary& s, double f, double zeta) {
+  const Eigen::VectorXd& x = s.frequency_hz;
+  const Eigen::Index n = x.size();
+  if (n < 3) return {0, 0};
+  const double df = (x[n - 1] - x[0]) / static_cast<double>(n - 1), w = std::max(2 * zeta * f, 2 * df);
+  auto at = [&](double q) {
+    const double pos = std::clamp((q - x[0]) / df, 0.0, static_cast<double>(n - 1));
+    const Eigen::Index k = std::min<Eigen::Index>(static_cast<Eigen::Index>(pos), n - 2);
+    const double t = pos - static_cast<double>(k);
+    return 10 * std::log10(std::max((1 - t) * s.background[k] + t * s.background[k + 1], 1e-300));
+  };
+  const double top = at(f);
+  return {top - at(f - w), top - at(f + w)};
+}
 
 Score score(const Case& c, const ModalData& truth, const std::vector<double>& snr, const IdentificationSummary& s) {
   Score sc;
   const int nt = truth.num_modes(), nr = static_cast<int>(s.modes.size());
   sc.reported = nr;
+  sc.band_lo = s.band_lo_hz, sc.band_hi = s.band_hi_hz;
+  sc.method = s.method;
   auto mac = [&](int r, int t) { return shape_mac(s.modes[static_cast<std::size_t>(r)].real_shape, truth.shapes.col(t)); };
   // Found: one to one, best MAC first, within 0.5 % and MAC >= 0.9.
   std::vector<char> expected(static_cast<std::size_t>(nt), 0);
@@ -266,17 +289,37 @@ Score score(const Case& c, const ModalData& truth, const std::vector<double>& sn
         const double d = std::abs(s.modes[static_cast<std::size_t>(q)].frequency_hz / truth.frequencies_hz[t] - 1);
         if (d < best) best = d, bm = mac(q, t);
       }
-      sc.missed.push_back(fmt::format("{:.4g} Hz (snr {:.0f} dB; nearest {:+.2f} %, MAC {:.2f})", truth.frequencies_hz[t], 10 * std::log10(snr[static_cast<std::size_t>(t)]),
-                                      nr ? 100 * best : 0.0, bm));
+      // Why: outside the band analysed, or the nearest rejected cluster (within 2 %) and its reason.
+      std::string why;
+      const double ft = truth.frequencies_hz[t];
+      if (ft < s.band_lo_hz || ft > s.band_hi_hz) why = fmt::format("; outside the band {:.4g}-{:.4g} Hz", s.band_lo_hz, s.band_hi_hz);
+      const RejectedCluster* rc = nullptr;
+      for (const RejectedCluster& q : s.rejected)
+        if (std::abs(q.frequency_hz / ft - 1) <= 0.02 && (!rc || std::abs(q.frequency_hz - ft) < std::abs(rc->frequency_hz - ft))) rc = &q;
+      if (rc) why += fmt::format("; rejected {:.4g} Hz: {} ({:.3g} vs {:.3g})", rc->frequency_hz, to_string(rc->reason), rc->value, rc->limit);
+      sc.missed.push_back(fmt::format("{:.4g} Hz (snr {:.0f} dB; nearest {:+.2f} %, MAC {:.2f}{})", ft, 10 * std::log10(snr[static_cast<std::size_t>(t)]),
+                                      nr ? 100 * best : 0.0, bm, why));
     }
   }
   const auto [true_r, true_t] = match(0.02, 0.8, false);
+  for (int r = 0; r < nr; ++r) {
+    const IdentifiedMode& m = s.modes[static_cast<std::size_t>(r)];
+    const auto [dl, dh] = side_drops(s, m.frequency_hz, m.damping_ratio);
+    sc.modes.push_back(fmt::format("{} {:.4g} Hz zeta {:.2f} % support {:.2f} MPC {:.2f} indicator {:+.1f} dB drops {:.1f} / {:.1f} dB contribution {:.3f}",
+                                   found_r[static_cast<std::size_t>(r)] >= 0 ? "found" : true_r[static_cast<std::size_t>(r)] >= 0 ? "true " : "SPUR ",
+                                   m.frequency_hz, 100 * m.damping_ratio, m.support, m.mpc, m.indicator_db, dl, dh, m.contribution));
+  }
   for (int r = 0; r < nr; ++r)
     if (true_r[static_cast<std::size_t>(r)] < 0) {
       ++sc.spurious;
-      sc.spurious_list.push_back(fmt::format("{:.4g} Hz (zeta {:.2f} %, support {:.2f}, MPC {:.2f})", s.modes[static_cast<std::size_t>(r)].frequency_hz,
-                                             100 * s.modes[static_cast<std::size_t>(r)].damping_ratio, s.modes[static_cast<std::size_t>(r)].support,
-                                             s.modes[static_cast<std::size_t>(r)].mpc));
+    {
+      const IdentifiedMode& m = s.modes[static_cast<std::size_t>(r)];
+      double best = 1e9, bm = 0;  // the nearest truth mode, for the log
+      for (int t = 0; t < nt; ++t)
+        if (std::abs(m.frequency_hz / truth.frequencies_hz[t] - 1) < std::abs(best)) best = m.frequency_hz / truth.frequencies_hz[t] - 1, bm = mac(r, t);
+      sc.spurious_list.push_back(fmt::format("{:.4g} Hz (zeta {:.2f} %, support {:.2f}, MPC {:.2f}, indicator {:+.1f} dB; nearest truth {:+.2f} %, MAC {:.2f})",
+                                             m.frequency_hz, 100 * m.damping_ratio, m.support, m.mpc, m.indicator_db, 100 * best, bm));
+    }
     }
   return sc;
 }
@@ -418,7 +461,7 @@ int main(int argc, char** argv) {
       }
       all[layout].add(sc[layout]);
       const std::string lay = layout ? "one file per channel" : "one file per test";
-      by_key["method " + c.method + " / " + lay].add(sc[layout]);
+      by_key["method " + (sc[layout].method.empty() ? c.method : sc[layout].method) + " / " + lay].add(sc[layout]);
       if (layout == 0) {
         by_key["excitation " + c.excitation].add(sc[layout]);
         by_key["structure " + c.structure].add(sc[layout]);
@@ -430,11 +473,14 @@ int main(int argc, char** argv) {
       equal_layouts += same_recordings(read[0], read[1]);
     }
     if (verbose || !sc[0].missed.empty() || !sc[0].spurious_list.empty() || !sc[0].error.empty()) {
-      fmt::print("seed {} ({}): {}, {}, {} sensors, zeta {:.2f} %, noise {:.1f} %, band 0-{:.4g} Hz, {} s: expected {}, found {}, reported {}, spurious {}{}\n", k, c.seed,
-                 c.structure, c.excitation, c.sensors, 100 * c.test.damping_ratio, 100 * c.test.noise, c.band_top, c.test.duration_s, sc[0].expected,
+      fmt::print("seed {} ({}): {}, {}, {} sensors, zeta {:.2f} %, noise {:.1f} %, band 0-{:.4g} Hz (analysed {:.4g}-{:.4g}), {:.3g} s: expected {}, found {}, reported {}, spurious {}{}\n", k,
+                 c.seed, c.structure, c.excitation, c.sensors, 100 * c.test.damping_ratio, 100 * c.test.noise, c.band_top, sc[0].band_lo, sc[0].band_hi,
+                 c.test.duration_s, sc[0].expected,
                  sc[0].found, sc[0].reported, sc[0].spurious, sc[0].error.empty() ? "" : " ERROR " + sc[0].error);
       for (const std::string& m : sc[0].missed) fmt::print("    missed {}\n", m);
       for (const std::string& m : sc[0].spurious_list) fmt::print("    spurious {}\n", m);
+      if (verbose)
+        for (const std::string& m : sc[0].modes) fmt::print("      {}\n", m);
       std::fflush(stdout);
     }
   }

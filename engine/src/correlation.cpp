@@ -98,12 +98,12 @@ Pairing pair_modes(const Eigen::MatrixXd& mac, const Eigen::VectorXd& fa, const 
   for (int i = 0; i < na; ++i)
     for (int j = 0; j < nb; ++j) {
       if (!(mac(i, j) >= min_mac)) continue;
-      if (max_ratio > 0 && freq && fa[i] > 0 && fb[j] > 0 && std::abs(std::log(fb[j] / fa[i])) > std::log(max_ratio)) continue;
+      // A partner more than a factor 2 away in frequency (or max_ratio, if tighter) is not plausible: a spatial
+      // alias (few sensors: a high mode can look like a low one at the measured DOFs) or a spurious mode.
+      const double bound = max_ratio > 0 ? std::min(max_ratio, kMaxPairingRatio) : kMaxPairingRatio;
+      if (freq && fa[i] > 0 && fb[j] > 0 && std::abs(std::log(fb[j] / fa[i])) > std::log(bound)) continue;
       const double df = freq && fa[i] > 0 ? std::min(1.0, std::abs(fb[j] - fa[i]) / fa[i]) : 0.0;
-      // A partner more than a factor 2 away in frequency is a spatial alias (few sensors: a high mode can look
-      // like a low one at the measured DOFs), never preferred to a nearer one of similar MAC.
-      const double lr = freq && fa[i] > 0 && fb[j] > 0 ? std::abs(std::log(fb[j] / fa[i])) : 0.0;
-      c.push_back({i, j, mac(i, j) - 0.1 * df - (lr > std::log(2.0) ? std::min(0.9, 0.2 * lr) : 0.0)});
+      c.push_back({i, j, mac(i, j) - 0.1 * df});
     }
   std::stable_sort(c.begin(), c.end(), [](const Cand& x, const Cand& y) { return x.score > y.score; });
   std::vector<char> ua(na, 0), ub(nb, 0);

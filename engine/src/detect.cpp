@@ -47,8 +47,8 @@ struct Paired {
 };
 
 // Pairs the modes of `data` (shapes at rows) with the model's elastic modes by MAC.
-Paired pair_with_model(const ModalData& data, const std::vector<int>& rows, const ModalResult& ref, int max_modes,
-                       double min_mac, const std::string& what) {
+Paired pair_with_model(const ModalData& data, const std::vector<int>& rows, const std::vector<int>& translations, const ModalResult& ref,
+                       int max_modes, double min_mac, const std::string& what) {
   std::vector<int> elastic;
   for (Eigen::Index j = 0; j < ref.eigenvalues.size(); ++j)
     if (!ref.rigid_body[j]) elastic.push_back(static_cast<int>(j));
@@ -63,14 +63,18 @@ Paired pair_with_model(const ModalData& data, const std::vector<int>& rows, cons
   std::vector<int> group_of(elastic.size(), -1);
   for (std::size_t g = 0; g < groups.size(); ++g)
     for (int j : groups[g]) group_of[static_cast<std::size_t>(j)] = static_cast<int>(g);
-  const Eigen::MatrixXd mac = subspace_mac_matrix(data.shapes, Pa, groups);
+  Eigen::MatrixXd mac = subspace_mac_matrix(data.shapes, Pa, groups);
+  // Modes the sensors cannot see are no partners: their MAC with a measurement is noise.
+  for (std::size_t j = 0; j < elastic.size(); ++j)
+    if (sensor_visibility(ref.modes.col(elastic[j]), rows, translations) < kMinPairingVisibility) mac.col(static_cast<Eigen::Index>(j)).setZero();
   const Pairing pr = pair_modes(mac, data.frequencies_hz, fe, min_mac);
   Paired out;
   for (int k : pr.unpaired_a) {
     double best = 0;
     for (Eigen::Index j = 0; j < mac.cols(); ++j) best = std::max(best, mac(k, j));
     out.warnings.push_back(what + " mode " + std::to_string(k + 1) + " (" + fmt(data.frequencies_hz[k]) +
-                           " Hz) pairs with no model mode (best MAC " + fmt(best, 3) + " < " + fmt(min_mac, 3) +
+                           " Hz) pairs with no model mode (MAC >= " + fmt(min_mac, 3) + " with a mode the sensors see, within a factor " +
+                           fmt(kMaxPairingRatio, 2) + " in frequency; best MAC " + fmt(best, 3) +
                            "); it is left out. Check the DOF labels and directions, or lower min_mac");
   }
   for (const ModePair& q : pr.pairs) {
@@ -246,7 +250,8 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
   S.time_modal = lap();
   m_serep = std::min<int>(m_serep, static_cast<int>(ref.eigenvalues.size()));
 
-  const Paired pc = pair_with_model(changed, rows, ref, o.modes, o.min_mac, "changed-state");
+  const std::vector<int> translations = translation_equations(model);
+  const Paired pc = pair_with_model(changed, rows, translations, ref, o.modes, o.min_mac, "changed-state");
   S.warnings.insert(S.warnings.end(), pc.warnings.begin(), pc.warnings.end());
   if (pc.used.empty()) throw InputError("detect: no changed-state mode pairs with a model mode; nothing to compare");
   S.used_modes = pc.used;
@@ -288,7 +293,7 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
   S.pseudo = pseudo_residual_force(S.residuals);
   S.pseudo_reference = Eigen::VectorXd::Zero(S.pseudo.size());
   if (reference_measured) {
-    const Paired pr = pair_with_model(refmeas, rows, ref, o.modes, o.min_mac, "reference-state");
+    const Paired pr = pair_with_model(refmeas, rows, translations, ref, o.modes, o.min_mac, "reference-state");
     S.warnings.insert(S.warnings.end(), pr.warnings.begin(), pr.warnings.end());
     if (!pr.used.empty())
       S.pseudo_reference = pseudo_residual_force(residuals_of(scaled_shapes(refmeas, pr), lambdas(refmeas, pr.used)));

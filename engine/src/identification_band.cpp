@@ -15,10 +15,7 @@ ModelBand band_from_model(const Model& model, const std::vector<MeasuredDof>& se
     if (model.node_index(d.node) >= 0 && model.dof_map().eq(model.node_index(d.node), d.dof) >= 0) known.push_back(d);
   if (known.empty()) throw InputError("identification band: no sensor is on a free DOF of the model");
   const std::vector<int> rows = measured_equations(model, known);
-  std::vector<int> translations;
-  for (int n = 0; n < static_cast<int>(model.nodes().size()); ++n)
-    for (int t = 0; t < 3; ++t)
-      if (model.dof_map().eq(n, static_cast<Dof>(t)) >= 0) translations.push_back(model.dof_map().eq(n, static_cast<Dof>(t)));
+  const std::vector<int> translations = translation_equations(model);
   const int want = std::max(1, std::min(modes, static_cast<int>(known.size())));
   EigenOptions eo;
   eo.num_modes = std::min(model.num_dofs(), 6 + 4 * want + 10);
@@ -30,12 +27,7 @@ ModelBand band_from_model(const Model& model, const std::vector<MeasuredDof>& se
   for (Eigen::Index j = 0; j < mr.eigenvalues.size() && static_cast<int>(b.visible_hz.size()) < want; ++j) {
     if (mr.rigid_body[j]) continue;
     if (1.2 * mr.frequencies_hz[j] > cap) break;  // a mode at the band's edge is identified poorly
-    double seen = 0, all = 0;
-    for (int r : rows) seen += mr.modes(r, j) * mr.modes(r, j);
-    for (int r : translations) all += mr.modes(r, j) * mr.modes(r, j);
-    seen /= static_cast<double>(rows.size());
-    all /= static_cast<double>(std::max<std::size_t>(translations.size(), 1));
-    if (seen >= 0.05 * all) b.visible_hz.push_back(mr.frequencies_hz[j]);
+    if (sensor_visibility(mr.modes.col(j), rows, translations) >= 0.05) b.visible_hz.push_back(mr.frequencies_hz[j]);
   }
   if (b.visible_hz.empty())
     throw InputError("identification band: the sensors see no mode of the model below " + std::to_string(cap) +

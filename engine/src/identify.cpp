@@ -149,7 +149,7 @@ bool IdentificationOptions::IsValid(std::string* why) const {
   if (!(cluster_tolerance > 0 && cluster_tolerance < 0.5)) return fail("the cluster tolerance must be in (0, 0.5)");
   if (block_rows < 0 || decimate < 0) return fail("block rows and decimation must be >= 0");
   if (!(min_mpc >= 0 && min_mpc <= 1)) return fail("the MPC limit must be in [0, 1]");
-  if (!(trough_db >= 0)) return fail("the indicator trough limit must be >= 0 dB");
+  if (!std::isfinite(min_peak_db) || !(max_edge_db > 0)) return fail("the indicator peak limit must be finite and the edge limit > 0 dB");
   if (!(merge_tolerance >= 0 && merge_tolerance < 0.5) || !(merge_mac > 0 && merge_mac <= 1))
     return fail("the merge tolerance must be in [0, 0.5) and the merge MAC in (0, 1]");
   if (segment < -1 || (segment > 0 && segment < 8)) return fail("the segment must be -1 (automatic), 0 (whole records) or >= 8 samples");
@@ -161,7 +161,8 @@ const char* to_string(Rejection r) {
   switch (r) {
     case Rejection::kFewOrders: return "few orders";
     case Rejection::kComplexShape: return "complex shape";
-    case Rejection::kIndicatorTrough: return "indicator trough";
+    case Rejection::kIndicatorTrough: return "no indicator peak";
+    case Rejection::kSpectralEdge: return "spectral edge";
     case Rejection::kSplit: return "split";
   }
   return "?";
@@ -380,13 +381,13 @@ IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationO
     return svd.matrixU().col(0) * svd.singularValues()[0];
   };
   std::vector<Candidate> cands(clusters.size());
-  std::vector<double> peak(clusters.size(), 0.0);
+  std::vector<internal::IndicatorEvidence> peak(clusters.size());
   for (std::size_t c = 0; c < clusters.size(); ++c) {
     cands[c].cluster = clusters[c];
     cands[c].strength = clusters[c].support;
     // The windowed data's peaks are wider by the window's decay.
     const double zw = clusters[c].damping_ratio + frf.window_decay / (2 * kPi * clusters[c].frequency_hz);
-    peak[c] = internal::indicator_peakness(s.frequency_hz, s.background.cwiseAbs2(), clusters[c].frequency_hz, zw);
+    peak[c] = internal::indicator_evidence(s.frequency_hz, s.background.cwiseAbs2(), clusters[c].frequency_hz, zw);
     if (clusters[c].support < internal::kShapedShare * o.min_cluster_fraction) continue;
     const std::complex<double> pw = internal::pole_of(clusters[c].frequency_hz, clusters[c].damping_ratio) - frf.window_decay;
     const Eigen::VectorXcd R = local_residues(w, H, pw, std::max(3 * zw * std::abs(pw), 5 * 2 * kPi * s.resolution_hz));
@@ -517,12 +518,12 @@ IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOpt
   // strongest member's phase); evidence.
   const std::vector<PoleCluster> clusters = internal::stabilize_and_cluster(orders, order_of, lo, hi, o, s);
   std::vector<Candidate> cands(clusters.size());
-  std::vector<double> peak(clusters.size(), 0.0);
+  std::vector<internal::IndicatorEvidence> peak(clusters.size());
   for (std::size_t c = 0; c < clusters.size(); ++c) {
     const PoleCluster& pc = clusters[c];
     cands[c].cluster = pc;
     cands[c].strength = pc.support;
-    peak[c] = internal::indicator_peakness(s.frequency_hz, s.background, pc.frequency_hz, pc.damping_ratio);
+    peak[c] = internal::indicator_evidence(s.frequency_hz, s.background, pc.frequency_hz, pc.damping_ratio);
     if (pc.support < internal::kShapedShare * o.min_cluster_fraction) continue;
     const std::size_t top = static_cast<std::size_t>(std::max_element(pc.member_weight.begin(), pc.member_weight.end()) - pc.member_weight.begin());
     const Eigen::VectorXcd ref = orders[pc.members[top].first][pc.members[top].second].vec.normalized();

@@ -25,17 +25,17 @@ bool impulsive_record(const Eigen::VectorXd& f) {
   return f.segment(a, w).squaredNorm() >= 0.9 * total;
 }
 
-// Sum of the outputs' auto spectra (the trace of the output spectral matrix), pooled over all records.
+// Sum of the outputs' (or the inputs') auto spectra (the trace of the spectral matrix), pooled over all records.
 struct Spectrum {
   Eigen::VectorXd f, level;  // level: PSD sum (continuous) or energy spectral density sum (impacts)
   double df = 0;
 };
 
-Spectrum output_spectrum(const std::vector<Recording>& recs, bool impulsive, int segment) {
+Spectrum channel_spectrum(const std::vector<Recording>& recs, bool impulsive, int segment, bool inputs) {
   Spectrum sp;
   const double fs = recs[0].sample_rate_hz;
   for (const Recording& r : recs) {
-    const std::vector<int> outs = r.output_channels();
+    const std::vector<int> outs = inputs ? r.input_channels() : r.output_channels();
     for (const Eigen::MatrixXd& x : r.records) {
       const int n = impulsive ? static_cast<int>(x.rows()) : segment;
       if (n > x.rows() || n < 8) continue;
@@ -154,7 +154,16 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
   p.impulsive = any_input && all_pulses;
   int segment = p.impulsive ? 0 : pow2_at_most(static_cast<double>(shortest) / 8);
   if (!p.impulsive && segment < 64) segment = pow2_at_most(static_cast<double>(shortest));
-  Spectrum sp = output_spectrum(recs, p.impulsive, segment);
+  Spectrum sp = channel_spectrum(recs, p.impulsive, segment, false);
+  if (p.impulsive) {
+    // Impacts: the outputs' energy over the hits' (a sum of |FRF|^2): the peaks of every mode the hits excite,
+    // not only of those below the hits' spectral roll-off.
+    const Spectrum in = channel_spectrum(recs, true, segment, true);
+    if (in.level.size() == sp.level.size()) {
+      const double tiny = std::max(1e-12 * in.level.maxCoeff(), 1e-300);  // lines the hits do not reach
+      for (Eigen::Index k = 0; k < sp.level.size(); ++k) sp.level[k] /= std::max(in.level[k], tiny);
+    }
+  }
   if (sp.level.size() < 8) {
     p.notes.push_back("records too short for a spectrum: the band and resolution are left as given");
     p.segment = o.segment > 0 ? o.segment : 0;
@@ -168,7 +177,7 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
     const int longest = pow2_at_most(static_cast<double>(shortest) / 4);
     while (segment < longest && !(widths[0] >= 4 * sp.df)) {
       segment *= 2;
-      sp = output_spectrum(recs, false, segment);
+      sp = channel_spectrum(recs, false, segment, false);
       const std::vector<double> again = peaks_of(sp, &widths);
       if (again.empty()) break;
       p.peaks_hz = again;

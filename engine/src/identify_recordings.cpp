@@ -173,11 +173,14 @@ IdentificationSummary identify_recordings(std::vector<Recording> recs, const std
   for (const Recording& r : recs) r.validate("identify: " + r.source);
   bool has_inputs = false;
   for (const Recording& r : recs) has_inputs = has_inputs || !r.input_channels().empty();
-  const std::string method = method_in.empty() ? (has_inputs ? "lscf" : "ssi") : method_in;
-  if (method == "lscf" && !has_inputs) throw InputError("identify: LSCF needs recordings with a force channel; these are output-only: use ssi");
-  if (method != "lscf" && method != "ssi") throw InputError("identify: unknown method '" + method + "' (lscf or ssi)");
   // The plan: band and resolution from the data where the options leave them open.
   const IdentificationPlan plan = plan_identification(recs, io_in);
+  // No method given: LSCF on the FRFs of impacts; SSI-cov on continuous records (output-only, or a random force:
+  // broadband, so the outputs alone identify the modes, without the leakage bias of Welch FRFs at the lowest
+  // modes of a wide band).
+  const std::string method = method_in.empty() ? (has_inputs && plan.impulsive ? "lscf" : "ssi") : method_in;
+  if (method == "lscf" && !has_inputs) throw InputError("identify: LSCF needs recordings with a force channel; these are output-only: use ssi");
+  if (method != "lscf" && method != "ssi") throw InputError("identify: unknown method '" + method + "' (lscf or ssi)");
   IdentificationOptions io = io_in;
   io.band_lo_hz = plan.band_lo_hz;
   io.band_hi_hz = plan.band_hi_hz;

@@ -157,9 +157,10 @@ std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<Raw
   return out;
 }
 
-double indicator_peakness(const Eigen::VectorXd& f, const Eigen::VectorXd& ind, double fr, double zeta) {
+IndicatorEvidence indicator_evidence(const Eigen::VectorXd& f, const Eigen::VectorXd& ind, double fr, double zeta) {
+  IndicatorEvidence e;
   const Eigen::Index n = f.size();
-  if (n < 3 || ind.size() != n) return 0;
+  if (n < 3 || ind.size() != n) return e;
   const double df = (f[n - 1] - f[0]) / static_cast<double>(n - 1);
   const double w = std::max(2 * zeta * fr, 2 * df);
   // The indicator in dB, linearly interpolated between lines.
@@ -175,10 +176,15 @@ double indicator_peakness(const Eigen::VectorXd& f, const Eigen::VectorXd& ind, 
   double top = -1e300;
   for (int q = -4; q <= 4; ++q) top = std::max(top, at(fr + q * h / 4));
   const bool has_lo = fr - w >= f[0], has_hi = fr + w <= f[n - 1];
-  if (has_lo && has_hi) return top - 0.5 * (at(fr - w) + at(fr + w));
-  if (has_lo) return top - at(fr - w);
-  if (has_hi) return top - at(fr + w);
-  return 0;
+  if (has_lo && has_hi) e.peak_db = top - 0.5 * (at(fr - w) + at(fr + w));
+  else if (has_lo) e.peak_db = top - at(fr - w);
+  else if (has_hi) e.peak_db = top - at(fr + w);
+  // The steepest fall either side beyond what the pole's own resonance allows at w: a power response falls by
+  // 10 log10(1 + (w / (zeta f))^2) there (other modes and noise only fill it in).
+  const double own = 10 * std::log10(1 + std::pow(w / std::max(zeta * fr, 1e-300), 2));
+  if (has_lo) e.edge_db = std::max(e.edge_db, top - at(fr - w) - own);
+  if (has_hi) e.edge_db = std::max(e.edge_db, top - at(fr + w) - own);
+  return e;
 }
 
 namespace {
@@ -198,7 +204,7 @@ double joint_support(const std::vector<Candidate>& cands, const std::vector<std:
 }
 }  // namespace
 
-std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& cands, const std::vector<double>& peakness,
+std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& cands, const std::vector<IndicatorEvidence>& ev,
                                                      const IdentificationOptions& o, std::size_t n_orders, IdentificationSummary& s) {
   auto reject = [&](const PoleCluster& c, Rejection r, double value, double limit, int into = -1) {
     RejectedCluster rc;
@@ -250,8 +256,10 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
       for (std::size_t k : g) reject(cands[k].cluster, Rejection::kFewOrders, support, o.min_cluster_fraction);
     } else if (mpc < o.min_mpc) {
       for (std::size_t k : g) reject(cands[k].cluster, Rejection::kComplexShape, mpc, o.min_mpc);
-    } else if (peakness[g[0]] < -o.trough_db) {
-      for (std::size_t k : g) reject(cands[k].cluster, Rejection::kIndicatorTrough, peakness[g[0]], -o.trough_db);
+    } else if (ev[g[0]].peak_db < o.min_peak_db) {
+      for (std::size_t k : g) reject(cands[k].cluster, Rejection::kIndicatorTrough, ev[g[0]].peak_db, o.min_peak_db);
+    } else if (ev[g[0]].edge_db > o.max_edge_db) {
+      for (std::size_t k : g) reject(cands[k].cluster, Rejection::kSpectralEdge, ev[g[0]].edge_db, o.max_edge_db);
     } else {
       ok = true;
     }
@@ -269,7 +277,7 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
   return kept;
 }
 
-void make_modes(const std::vector<Candidate>& cands, const std::vector<double>& peakness, const std::vector<std::vector<std::size_t>>& accepted,
+void make_modes(const std::vector<Candidate>& cands, const std::vector<IndicatorEvidence>& ev, const std::vector<std::vector<std::size_t>>& accepted,
                 std::size_t n_orders, IdentificationSummary& s) {
   s.modes.clear();
   for (const std::vector<std::size_t>& g : accepted) {
@@ -280,7 +288,7 @@ void make_modes(const std::vector<Candidate>& cands, const std::vector<double>& 
     m.damping_ratio = c.cluster.damping_ratio;
     m.order_frequency_std_hz = m.frequency_std_hz = c.cluster.frequency_std_hz;
     m.damping_std = c.cluster.damping_std;
-    m.indicator_db = peakness[g[0]];
+    m.indicator_db = ev[g[0]].peak_db;
     m.shape = c.shape;
     m.mpc = modal_phase_collinearity(c.shape);
     m.real_shape = real_normalize(c.shape);

@@ -65,6 +65,22 @@ void ModalData::validate(const std::string& what) const {
       if (dofs[i] == dofs[j]) throw InputError(what + ": DOF " + to_string(dofs[i]) + " is listed twice");
 }
 
+std::vector<int> translation_equations(const Model& model) {
+  std::vector<int> eq;
+  for (int n = 0; n < static_cast<int>(model.nodes().size()); ++n)
+    for (int t = 0; t < 3; ++t)
+      if (model.dof_map().eq(n, static_cast<Dof>(t)) >= 0) eq.push_back(model.dof_map().eq(n, static_cast<Dof>(t)));
+  return eq;
+}
+
+double sensor_visibility(const Eigen::Ref<const Eigen::VectorXd>& mode, const std::vector<int>& rows, const std::vector<int>& translations) {
+  double seen = 0, all = 0;
+  for (int r : rows) seen += mode[r] * mode[r];
+  for (int r : translations) all += mode[r] * mode[r];
+  if (rows.empty() || translations.empty() || !(all > 0)) return 0;
+  return (seen / static_cast<double>(rows.size())) / (all / static_cast<double>(translations.size()));
+}
+
 std::vector<int> measured_equations(const Model& model, const std::vector<MeasuredDof>& dofs) {
   std::vector<int> eq;
   eq.reserve(dofs.size());

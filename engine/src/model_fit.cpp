@@ -92,9 +92,7 @@ class Evaluator {
                        std::to_string(meas.num_modes()) + " measured modes");
     rows_ = measured_equations(pm.model(), meas.dofs);
     const Model& model = pm.model();
-    for (int n = 0; n < static_cast<int>(model.nodes().size()); ++n)
-      for (int t = 0; t < 3; ++t)
-        if (model.dof_map().eq(n, static_cast<Dof>(t)) >= 0) translations_.push_back(model.dof_map().eq(n, static_cast<Dof>(t)));
+    translations_ = translation_equations(model);
     const int n = model.num_dofs();
     bool springs = false;
     for (int p = 0; p < pm.num_parameters(); ++p)  // springs (and custom terms) may tie a free-free model down
@@ -258,12 +256,8 @@ class Evaluator {
     Eigen::MatrixXd mac = mac_matrix(meas_.shapes, Pa);
     // Modes the sensors cannot see are no partners: their MAC with a measurement is noise.
     if (o_.min_visibility > 0 && !translations_.empty())
-      for (std::size_t j = 0; j < ev_.elastic.size(); ++j) {
-        double all = 0;
-        for (int r : translations_) all += ev_.ms.Phi(r, ev_.elastic[j]) * ev_.ms.Phi(r, ev_.elastic[j]);
-        const double seen = Pa.col(static_cast<Eigen::Index>(j)).squaredNorm() / static_cast<double>(std::max<Eigen::Index>(a, 1));
-        if (seen < o_.min_visibility * all / static_cast<double>(translations_.size())) mac.col(static_cast<Eigen::Index>(j)).setZero();
-      }
+      for (std::size_t j = 0; j < ev_.elastic.size(); ++j)
+        if (sensor_visibility(ev_.ms.Phi.col(ev_.elastic[j]), rows_, translations_) < o_.min_visibility) mac.col(static_cast<Eigen::Index>(j)).setZero();
     const Pairing pr = pair_modes(mac, meas_.frequencies_hz, fe, o_.min_mac, o_.max_frequency_ratio);
     const int p = meas_.num_modes();
     ev_.pair.assign(p, -1);

@@ -37,9 +37,16 @@ struct PoleCluster {
 std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<RawPole>>& orders, const std::vector<int>& order_of, double lo,
                                                double hi, const IdentificationOptions& o, IdentificationSummary& s);
 
-/// How far (dB) the mode indicator stands above (+) or below (-) the straight line, in dB, between its values at
-/// f -+ w, w = max(2 zeta f, 2 df) (df the line spacing); at a band edge, against the one side it has.
-double indicator_peakness(const Eigen::VectorXd& frequency_hz, const Eigen::VectorXd& indicator, double f, double zeta);
+/// The mode indicator around a pole (f, zeta), with w = max(2 zeta f, 2 df) (df the line spacing):
+///   peak_db  how far (dB) it stands above (+) or below (-) the straight line, in dB, between its values at
+///            f -+ w; at a band edge, against the one side it has;
+///   edge_db  how much further it falls on its steeper side, from f to f -+ w, than the pole's own resonance
+///            can: 10 log10(1 + (w / (zeta f))^2) (> 0: a spectral edge, e.g. where the excitation or an
+///            anti-alias filter stops, not a resonance).
+struct IndicatorEvidence {
+  double peak_db = 0, edge_db = 0;
+};
+IndicatorEvidence indicator_evidence(const Eigen::VectorXd& frequency_hz, const Eigen::VectorXd& indicator, double f, double zeta);
 
 /// A cluster with its shape, for the evidence checks.
 struct Candidate {
@@ -52,14 +59,14 @@ struct Candidate {
 /// their support). Splits are merged first (a weaker cluster within the merge window with the same shape joins
 /// the stronger), then each group is checked: joint support, MPC and mode indicator of its strongest cluster.
 /// Returns the accepted modes, ascending in frequency, each as its strongest candidate followed by the splits
-/// merged into it; appends every rejected candidate to s.rejected. `peakness` gives each candidate's
-/// indicator_peakness; `n_orders` the number of model orders.
-std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& candidates, const std::vector<double>& peakness,
+/// merged into it; appends every rejected candidate to s.rejected. `evidence` gives each candidate's
+/// indicator_evidence; `n_orders` the number of model orders.
+std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& candidates, const std::vector<IndicatorEvidence>& evidence,
                                                      const IdentificationOptions& o, std::size_t n_orders, IdentificationSummary& s);
 
 /// The accepted modes as IdentifiedModes (frequency, damping, spreads and shape of the strongest cluster, the
 /// joint support of all), and the diagram's poles marked with their mode.
-void make_modes(const std::vector<Candidate>& candidates, const std::vector<double>& peakness, const std::vector<std::vector<std::size_t>>& accepted,
+void make_modes(const std::vector<Candidate>& candidates, const std::vector<IndicatorEvidence>& evidence, const std::vector<std::vector<std::size_t>>& accepted,
                 std::size_t n_orders, IdentificationSummary& s);
 
 /// Clusters with at least this share of min_cluster_fraction get a shape and the evidence checks (weaker ones

@@ -25,11 +25,14 @@ struct Pairing {
   const ModePair* of_a(int a) const;
 };
 
+/// Partners further apart in frequency than this factor are never paired (issue 16): a spatial alias (few
+/// sensors: a high mode can look like a low one at the measured DOFs) or a spurious mode, not a partner.
+constexpr double kMaxPairingRatio = 2.0;
+
 /// One-to-one pairing by MAC: repeatedly takes the pair with the highest score MAC - 0.1 min(1, |f_b - f_a|/f_a)
-/// (MAC decides; the frequency breaks near-ties such as the twin modes of symmetric structures), less min(0.9, 0.2 |ln(f_b/f_a)|)
-/// for partners more than a factor 2 apart in frequency (spatial aliases at few sensors), among pairs with
-/// MAC >= min_mac. fa, fb may be empty (no frequency tie-break). With max_ratio > 0, partners further apart in
-/// frequency than that factor are not plausible and never paired (the mode is left unpaired).
+/// (MAC decides; the frequency breaks near-ties such as the twin modes of symmetric structures), among pairs with
+/// MAC >= min_mac within a frequency ratio of kMaxPairingRatio (or max_ratio, when > 0 and tighter); a mode
+/// without one is left unpaired. fa, fb may be empty (no frequency tie-break, no ratio bound).
 Pairing pair_modes(const Eigen::MatrixXd& mac, const Eigen::VectorXd& fa, const Eigen::VectorXd& fb,
                    double min_mac = 0.5, double max_ratio = 0);
 

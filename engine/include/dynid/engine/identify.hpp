@@ -16,8 +16,12 @@
 //        support below min_cluster_fraction (not stable over enough orders);
 //        shape: MPC below min_mpc (not a normal mode: noise or a mathematical pole);
 //        mode indicator (CMIF for FRFs, the first singular value of the output spectral matrix for output-only
-//          data) more than trough_db below the straight line (in dB) between its values a few half-power
-//          bandwidths either side: the pole sits in a trough (an anti-resonance), not on a peak or a shoulder;
+//          data) less than min_peak_db above the straight line (in dB) between its values one half-power
+//          bandwidth either side (w = max(2 zeta f, 2 line spacings)): no peak of its own there (a mode the
+//          sensors barely see, whose shape is noise, or a pole in a trough or on the flank of another mode);
+//        a spectral edge: the indicator falls from f to f -+ w more than max_edge_db further than the pole's own
+//          resonance can (10 log10(1 + (w / zeta f)^2)): the spectrum stops there (the excitation's band, an
+//          anti-alias filter) and the pole models the edge, not a resonance;
 //        a split: within max(merge_tolerance, zeta) in frequency of a stronger cluster (one half-power
 //          half-bandwidth) with a shape MAC >= merge_mac: one physical mode whose poles drifted over orders. Splits
 //          are merged before the other checks: the group's support counts, per order, its best pole; its
@@ -60,7 +64,8 @@ struct IdentificationOptions {
   double cluster_tolerance = 0.01;    ///< half-width of a cluster's window (relative frequency)
   // Evidence a cluster needs to be reported as a mode (see the header comment).
   double min_mpc = 0.5;             ///< modal phase collinearity of its shape
-  double trough_db = 3;             ///< how far below its surroundings the mode indicator may sit
+  double min_peak_db = 3;           ///< how far above its surroundings the mode indicator must stand
+  double max_edge_db = 10;          ///< how much steeper than its resonance the indicator may fall beside it
   double merge_tolerance = 0.03;    ///< clusters this close (relative, or zeta if wider) ...
   double merge_mac = 0.9;           ///< ... with shapes this alike are one mode
   // SSI-cov.
@@ -112,10 +117,11 @@ struct IdentifiedMode {
 enum class Rejection {
   kFewOrders,        ///< support below min_cluster_fraction
   kComplexShape,     ///< MPC below min_mpc
-  kIndicatorTrough,  ///< the mode indicator sits in a trough there
+  kIndicatorTrough,  ///< the mode indicator has no peak there (below min_peak_db)
+  kSpectralEdge,     ///< the mode indicator falls beside it faster than a resonance can (an excitation edge)
   kSplit             ///< a split of a stronger cluster with the same shape (merged into it)
 };
-const char* to_string(Rejection r);  // "few orders", "complex shape", "indicator trough", "split"
+const char* to_string(Rejection r);  // "few orders", "complex shape", "no indicator peak", "spectral edge", "split"
 
 struct RejectedCluster {
   double frequency_hz = 0, damping_ratio = 0;
@@ -152,8 +158,9 @@ struct IdentificationSummary {
 };
 
 /// The band and frequency resolution for recordings when the options leave them open: from the peaks of the
-/// mode indicator (first singular value of the output cross-spectral matrix; whole records for impacts,
-/// Welch segments of an eighth of the record otherwise).
+/// summed output spectra (Welch segments of an eighth of the record), for impacts of the summed output energy
+/// spectra over the summed hit energy spectra (whole records: a sum of |FRF|^2, so that the modes above the
+/// hits' spectral roll-off show their peaks too).
 ///   band: [0.5 x lowest peak, min(1.25 x highest peak, 0.45 x sampling rate)], over the peaks that stand
 ///         >= 10 dB above their surroundings (prominence) and >= 10 dB above the spectrum's 10th-percentile
 ///         level (the noise floor); the whole range below 0.45 fs when there is none.
@@ -203,9 +210,11 @@ struct ModelBand {
 ModelBand band_from_model(const Model& model, const std::vector<MeasuredDof>& sensors, double nyquist_hz, int modes = 8);
 
 /// Recordings identified as a whole: "lscf" on FRFs (recordings with force channels; a roving hammer gives one
-/// recording per hit location) or "ssi" (output-only; records of all recordings concatenated); "" picks by the
-/// data. The band and resolution come from plan_identification where the options leave them open; then the
-/// split-data uncertainty (header comment) when options.split_uncertainty.
+/// recording per hit location) or "ssi" (the output channels; records of all recordings concatenated); "" picks
+/// by the data: lscf for impacts (every force record a blow), ssi for continuous records, output-only or with a
+/// random force (broadband: the outputs alone identify the modes, free of the leakage bias Welch FRFs have at
+/// the lowest modes of a wide band). The band and resolution come from plan_identification where the options
+/// leave them open; then the split-data uncertainty (header comment) when options.split_uncertainty.
 IdentificationSummary identify_recordings(std::vector<Recording> recordings, const std::string& method,
                                           const IdentificationOptions& options);
 /// FRFs identified with LSCF (the band from plan_identification where the options leave it open), with the

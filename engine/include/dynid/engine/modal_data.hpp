@@ -42,6 +42,16 @@ struct ModalData {
 /// or the DOF is not a DOF of the model (inactive or restrained), with what the node does have.
 std::vector<int> measured_equations(const Model& model, const std::vector<MeasuredDof>& dofs);
 
+/// Equation numbers of the translational DOFs (x, y, z) of every node.
+std::vector<int> translation_equations(const Model& model);
+/// How well sensors see a mode (a column of a modal result): its mean square at the sensor equations `rows`
+/// over its mean square at `translations` (translation_equations). 1 = as well as an average translation; an
+/// axial or out-of-plane mode under transverse or in-plane sensors is near 0 (its MAC with any measurement is
+/// noise). 0 when the mode does not move the translations.
+double sensor_visibility(const Eigen::Ref<const Eigen::VectorXd>& mode, const std::vector<int>& rows, const std::vector<int>& translations);
+/// Model modes seen below this visibility are no pairing partners for measured modes (issue 16).
+constexpr double kMinPairingVisibility = 0.01;
+
 /// Every free DOF of a model, in equation order.
 std::vector<MeasuredDof> all_dofs(const Model& model);
 /// The free DOFs of the given types (e.g. translations) at every node (or at `nodes` if not empty).

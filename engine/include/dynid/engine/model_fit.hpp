@@ -53,7 +53,7 @@ struct FitOptions {
   /// Model modes the sensors cannot see are not pairing partners: those whose mean square at the measured DOFs
   /// is below this share of their mean square over all translational DOFs (axial or out-of-plane modes under
   /// transverse or in-plane sensors), whose MAC with any measurement is noise.
-  double min_visibility = 0.01;
+  double min_visibility = kMinPairingVisibility;
   int extra_modes = 10;           ///< model modes computed beyond the measured ones (pairing, expansion)
   /// Models up to this many DOFs are solved densely with every mode (exact shape derivatives); larger ones by
   /// shift-invert Lanczos for the modes needed, shape derivatives with a static correction. With hundreds of

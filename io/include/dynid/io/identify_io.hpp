@@ -16,7 +16,7 @@ namespace dynid {
 ///             "mpc", "shape": {dof: value}, "contribution", "poles", "support", "indicator_db",
 ///             "order_frequency_std_hz", "same_shape_as" (twins)}],
 ///  "rejected": [{"frequency_hz", "damping_ratio", "poles", "support", "reason" ("few orders", "complex shape",
-///               "indicator trough", "split"), "value", "limit", "merged_into" (split: mode number)}],
+///               "no indicator peak", "spectral edge", "split"), "value", "limit", "merged_into" (split: mode number)}],
 ///  "stabilization": {"poles": [[order, frequency_hz, damping_ratio, class, mode]], "frequency_hz", "background",
 ///                    "background_label"},
 ///  "notes": [...]}; the modes array reads back with read_modal_data.
