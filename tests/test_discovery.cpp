@@ -10,6 +10,7 @@
 #include "dynid/engine/candidate_checks.hpp"
 #include "dynid/engine/discovery.hpp"
 #include "dynid/engine/modal.hpp"
+#include "discovery/stages.hpp"
 #include "dynid/mesh/generators.hpp"
 #include "test_util.hpp"
 
@@ -72,6 +73,44 @@ const PhysicalValue* value(const ScoredHypothesis& h, const std::string& name) {
 // explicit DOF); the candidate condenses the released rotation into the column's first element. Same physics,
 // so discovery must name it and recover k to the Guyan condensation's accuracy (the released rotation's mass is
 // condensed statically: 1 % here).
+// The prediction-error level of a hypothesis (engine/src/discovery/fit.cpp, level()): the closed form against a
+// direct numerical maximization of its log likelihood, ln L(u) = -(n/2) ln u - chi2/(2u) - (u - 1)/(2a^2) on
+// u >= 1 (golden section on ln u; tolerance 1e-6 relative, the search's own resolution is 1e-9); within the noise
+// the level is the noise's.
+TEST(Discovery, ErrorLevelMaximizesTheLikelihoodWithTheFormErrorPrior) {
+  internal::Problem p;
+  p.modes = 5;
+  p.n = 5 * (1 + 12);
+  p.noise.frequency = 1e-4;
+  p.noise.shape = 0.03;
+  auto numeric = [](double chi2, int n, double a) {
+    auto L = [&](double lu) {
+      const double u = std::exp(lu);
+      return -0.5 * n * lu - 0.5 * chi2 / u - 0.5 * (u - 1) / (a * a);
+    };
+    double lo = 0, hi = 40;
+    const double g = 0.5 * (std::sqrt(5.0) - 1);
+    while (hi - lo > 1e-11) {
+      const double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
+      if (L(x1) < L(x2)) lo = x1;
+      else hi = x2;
+    }
+    return std::exp(0.5 * (lo + hi));
+  };
+  const DiscoveryOptions& o = p.options;
+  for (double chi2f : {1e2, 3e4, 1e6, 1e9})
+    for (double chi2s : {30.0, 6e2, 5e4}) {
+      const internal::ErrorScale s = internal::error_scale(p, chi2f + chi2s, chi2f);
+      const double uf = numeric(chi2f, p.modes, o.form_error_frequency / p.noise.frequency);
+      const double us = numeric(chi2s, p.n - p.modes, o.form_error_shape / p.noise.shape);
+      EXPECT_NEAR(s.frequency * s.frequency, uf, 1e-6 * uf) << chi2f;
+      EXPECT_NEAR(s.shape * s.shape, us, 1e-6 * us) << chi2s;
+    }
+  const internal::ErrorScale within = internal::error_scale(p, 3.0 + 40.0, 3.0);  // below n in each type
+  EXPECT_EQ(within.frequency, 1.0);
+  EXPECT_EQ(within.shape, 1.0);
+}
+
 TEST(Discovery, FlexibleBaseMatchesAnExplicitSpring) {
   const Model analysis = make_frame2d(portal());
   Model truth = make_frame2d(portal());

@@ -99,7 +99,6 @@ SetFit fit_set(const Problem& p, const std::vector<const Candidate*>& set, const
     const std::vector<CandidateParameter> ps = set[k]->parameters();
     const Eigen::Index np = static_cast<Eigen::Index>(ps.size());
     out.theta.push_back(s.theta.segment(first[k], np));
-    out.stddev.push_back(s.stddev.segment(first[k], np));
     const double th = s.theta[first[k]], tol = 1e-6 * (ps[0].upper - ps[0].lower);
     if (std::abs(th - ps[0].lower) < tol && ps[0].lower != ps[0].nominal) out.at_bound = true;
     if (std::abs(th - ps[0].upper) < tol && ps[0].upper != ps[0].nominal) out.at_bound = true;

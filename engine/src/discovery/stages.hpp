@@ -52,7 +52,7 @@ struct Problem {
 struct SetFit {
   bool ok = false;
   std::vector<const Candidate*> set;
-  std::vector<Eigen::VectorXd> theta, stddev;  ///< per candidate, its own parameters
+  std::vector<Eigen::VectorXd> theta;  ///< per candidate, its own parameters
   double chi2 = 0;                 ///< whitened residual sum of squares at the solution
   double chi2_frequency = 0;       ///< its frequency part
   Eigen::VectorXd residuals;       ///< the whitened residuals at the solution (what the set predicts, less the data)
