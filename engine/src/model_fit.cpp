@@ -14,6 +14,7 @@
 #include "dynid/engine/sensitivity.hpp"
 #include "dynid/mesh/error.hpp"
 #include "dynid/solvers/eigen.hpp"
+#include "internal/free_parameters.hpp"
 
 namespace dynid {
 
@@ -553,13 +554,9 @@ MeasuredNoise measured_noise(const ModalData& d, const FitOptions& options) {
   return m;
 }
 
-FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta0,
-                          const std::vector<char>& is_free, const FitOptions& o) {
-  std::string why;
-  if (!o.IsValid(&why)) throw InputError("fit options: " + why);
-  measured.validate("measured modal data");
-  if (theta0.size() != pm.num_parameters())
-    throw InputError("fit: " + std::to_string(theta0.size()) + " start values for " + std::to_string(pm.num_parameters()) + " parameters");
+namespace internal {
+
+std::vector<int> free_parameters(const ParametricModel& pm, const std::vector<char>& is_free, const FitOptions& o) {
   if (!is_free.empty() && static_cast<int>(is_free.size()) != pm.num_parameters())
     throw InputError("fit: free-parameter mask has the wrong size");
   std::vector<char> tied(static_cast<std::size_t>(pm.num_parameters()), 0);
@@ -575,6 +572,19 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
   std::vector<int> free;
   for (int p = 0; p < pm.num_parameters(); ++p)
     if ((is_free.empty() || is_free[p]) && !tied[p]) free.push_back(p);
+  return free;
+}
+
+}  // namespace internal
+
+FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta0,
+                          const std::vector<char>& is_free, const FitOptions& o) {
+  std::string why;
+  if (!o.IsValid(&why)) throw InputError("fit options: " + why);
+  measured.validate("measured modal data");
+  if (theta0.size() != pm.num_parameters())
+    throw InputError("fit: " + std::to_string(theta0.size()) + " start values for " + std::to_string(pm.num_parameters()) + " parameters");
+  const std::vector<int> free = internal::free_parameters(pm, is_free, o);
   if (free.empty()) throw InputError("fit: no free parameters");
   for (int p = 0; p < pm.num_parameters(); ++p) {
     const Parameter& q = pm.parameter(p);

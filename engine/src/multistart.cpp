@@ -7,6 +7,7 @@
 #include <numeric>
 
 #include "dynid/mesh/error.hpp"
+#include "internal/free_parameters.hpp"
 #include "internal/parallel.hpp"
 
 namespace dynid {
@@ -45,12 +46,7 @@ MultiStartSummary fit_multistart(const ParametricModel& pm, const ModalData& mea
   if (!ms.IsValid(&why)) throw InputError("multistart options: " + why);
   if (theta0.size() != pm.num_parameters())
     throw InputError("multistart: " + std::to_string(theta0.size()) + " start values for " + std::to_string(pm.num_parameters()) + " parameters");
-  std::vector<char> tied(static_cast<std::size_t>(pm.num_parameters()), 0);
-  for (const auto& t : o.ties)
-    if (t.first >= 0 && t.first < pm.num_parameters()) tied[static_cast<std::size_t>(t.first)] = 1;
-  std::vector<int> free;
-  for (int p = 0; p < pm.num_parameters(); ++p)
-    if ((is_free.empty() || is_free[static_cast<std::size_t>(p)]) && !tied[static_cast<std::size_t>(p)]) free.push_back(p);
+  const std::vector<int> free = internal::free_parameters(pm, is_free, o);
   for (int p : free)
     if (!std::isfinite(pm.parameter(p).lower) || !std::isfinite(pm.parameter(p).upper))
       throw InputError("multistart: parameter '" + pm.parameter(p).name +
