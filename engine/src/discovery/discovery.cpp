@@ -90,13 +90,7 @@ void check_set_aside(const Problem& p, const ModalData& measured, const SetFit& 
   for (const SetAside& s : *aside)
     if (s.reason == SetAside::Reason::kNoPartner) idx.push_back(s.mode);
   if (idx.empty() || !f.ok) return;
-  ModalData d = measured;
-  d.frequencies_hz.resize(static_cast<Eigen::Index>(idx.size()));
-  d.shapes.resize(measured.shapes.rows(), static_cast<Eigen::Index>(idx.size()));
-  for (std::size_t k = 0; k < idx.size(); ++k) {
-    d.frequencies_hz[static_cast<Eigen::Index>(k)] = measured.frequencies_hz[idx[k]];
-    d.shapes.col(static_cast<Eigen::Index>(k)) = measured.shapes.col(idx[k]);
-  }
+  ModalData d = select_modes(measured, idx);
   d.damping_ratios.resize(0), d.mpc.resize(0), d.frequency_std_hz.resize(0), d.damping_std.resize(0), d.shape_std.resize(0);
   d.shape_entry_std.resize(0, 0);
   ParametricModel pm(*p.model);
@@ -145,9 +139,9 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   p.n = p.modes * (1 + static_cast<int>(p.data.dofs.size()));
   S.data = p.n;
   S.eigen_solves = 2;
-  const double chi2_0 = sc.chi2;
   p.chi2_0 = sc.chi2;
   p.chi2_0_frequency = sc.chi2_frequency;
+  const double chi2_0 = p.chi2_0;
   S.chi2_frequency_before = sc.chi2_frequency / p.modes;
   S.chi2_shape_before = (chi2_0 - sc.chi2_frequency) / std::max(1, p.n - p.modes);
   std::vector<char> forced0(sc.paired.size());
@@ -180,7 +174,7 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   S.eigen_solves += recal.evaluations;
 
   Selection sel;
-  if (!consistent) sel = select(p, singles, chi2_0, S.before);
+  if (!consistent) sel = select(p, singles, S.before);
   else {
     sel.chi2_best = chi2_0;
     for (const SetFit& f : singles)
@@ -192,14 +186,10 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
     S.noise_scale_frequency = es.frequency;
     S.noise_scale_shape = es.shape;
   }
-  auto relative = [&](const SetFit& f) {
-    const double span = chi2_0 - sel.chi2_best;
-    return f.ok && span > 0 ? std::clamp((chi2_0 - f.chi2) / span, 0.0, 1.0) : 0.0;
-  };
   auto score = [&](const SetFit& f, std::size_t k) {
     ScoredHypothesis h = scored(p, f, k);
     h.log_evidence = log_evidence(p, f);
-    h.explained = relative(f);
+    h.explained = explained_share(p, f, sel.chi2_best);
     h.significance = significance(p, f, k);
     return h;
   };

@@ -279,6 +279,11 @@ Eigen::Index offset_of(const SetFit& f, std::size_t k) {
 
 }  // namespace
 
+double explained_share(const Problem& p, const SetFit& f, double chi2_best) {
+  const double span = p.chi2_0 - chi2_best;
+  return f.ok && span > 0 ? std::clamp((p.chi2_0 - f.chi2) / span, 0.0, 1.0) : 0.0;
+}
+
 double significance(const Problem& p, const SetFit& f, std::size_t k) {
   if (!f.ok) return 0;
   // The magnitude parameter (the first: a mass, a stiffness, a fraction) against its nominal.

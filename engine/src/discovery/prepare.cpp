@@ -19,7 +19,8 @@ double median(std::vector<double> v) {
   return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
-// A copy of `d` with only the modes in `keep`.
+}  // namespace
+
 ModalData select_modes(const ModalData& d, const std::vector<int>& keep) {
   ModalData o = d;
   const Eigen::Index n = static_cast<Eigen::Index>(keep.size());
@@ -45,8 +46,6 @@ ModalData select_modes(const ModalData& d, const std::vector<int>& keep) {
   }
   return o;
 }
-
-}  // namespace
 
 NoiseModel noise_model(const ModalData& data, const DiscoveryOptions& o, std::vector<std::string>* warnings) {
   NoiseModel nm;

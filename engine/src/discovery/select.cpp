@@ -23,11 +23,10 @@ constexpr double kMacTolerance = 1e-4;
 
 struct Search {
   const Problem& p;
-  double chi2_0;
   FitQuality before;
   double chi2_best = 0;
   int solves = 0;
-  std::map<std::vector<const Candidate*>, SetFit> cache;  // by the set's candidates, sorted
+  std::map<std::vector<const Candidate*>, SetFit> cache{};  // by the set's candidates, sorted
 
   static std::vector<const Candidate*> key(std::vector<const Candidate*> s) {
     std::sort(s.begin(), s.end());
@@ -58,10 +57,7 @@ struct Search {
 
   double evidence(const SetFit& f) const { return log_evidence(p, f); }
   // Share of the misfit removed, relative to the best any explored set reached (reported).
-  double explained(const SetFit& f) const {
-    const double span = chi2_0 - chi2_best;
-    return span > 0 ? std::clamp((chi2_0 - f.chi2) / span, 0.0, 1.0) : 0.0;
-  }
+  double explained(const SetFit& f) const { return explained_share(p, f, chi2_best); }
   // A set that may stand as an explanation: fitted, inside its bounds, no worse than the model as given in its
   // largest frequency error or its mean MAC (to kMacTolerance: MAC differences below it are rounding, not fit),
   // every effect significant, at most one parameter per two measured modes.
@@ -78,7 +74,7 @@ struct Search {
   bool worth(const SetFit& from, const SetFit& to) const {
     if (!admissible(to)) return false;
     if (evidence(to) - evidence(from) < p.options.decisive) return false;
-    if (from.chi2 - to.chi2 < p.options.min_share * std::max(0.0, chi2_0 - chi2_best)) return false;
+    if (from.chi2 - to.chi2 < p.options.min_share * std::max(0.0, p.chi2_0 - chi2_best)) return false;
     return from.chi2 - to.chi2 >= p.options.further * std::max(0.0, from.chi2 - chi2_best);
   }
 };
@@ -156,11 +152,11 @@ SelectionStep step_of(const Search& s, SelectionStep::Action a, const std::strin
 
 }  // namespace
 
-Selection select(const Problem& p, const std::vector<SetFit>& singles, double chi2_0, const FitQuality& before) {
-  Search s{p, chi2_0, before};
+Selection select(const Problem& p, const std::vector<SetFit>& singles, const FitQuality& before) {
+  Search s{p, before};
   for (const SetFit& f : singles) s.cache.emplace(Search::key(f.set), f);
   auto update_best = [&]() {
-    s.chi2_best = chi2_0;
+    s.chi2_best = p.chi2_0;
     for (const auto& [k, f] : s.cache)
       if (f.ok && !f.at_bound && f.chi2 < s.chi2_best) s.chi2_best = f.chi2;
   };

@@ -68,6 +68,8 @@ struct SetFit {
 };
 
 // ---- prepare ----
+/// A copy of `d` with only the modes in `keep` (every per-mode field cut alike).
+ModalData select_modes(const ModalData& d, const std::vector<int>& keep);
 /// The noise model (stated, the data's own, or the conservative default with a warning).
 NoiseModel noise_model(const ModalData& data, const DiscoveryOptions& o, std::vector<std::string>* warnings);
 /// Free-free models: measured modes that are rigid-body motions on the test's suspension (below the first elastic
@@ -116,6 +118,9 @@ double scaled_norm2(const Problem& p, const Eigen::VectorXd& r, const ErrorScale
 double log_evidence(const Problem& p, const SetFit& f);
 /// Posterior standard deviations of a set's parameters (all candidates in order) at the levels `s`.
 Eigen::VectorXd posterior_stddev(const SetFit& f, const ErrorScale& s);
+/// Share of the model's misfit (Problem::chi2_0) a fitted set removes, relative to the lowest chi-square any explored
+/// set reached (chi2_best); 0 for a set that could not be fitted.
+double explained_share(const Problem& p, const SetFit& f, double chi2_best);
 /// Smallest |theta - nominal| / std over the set's parameters of candidate k (at the set's levels); 0 on a bound.
 double significance(const Problem& p, const SetFit& f, std::size_t k);
 /// One candidate of a fitted set as reported: its values with their standard deviations.
@@ -135,6 +140,6 @@ struct Selection {
   double chi2_best = 0;            ///< the lowest chi-square any explored set reached
   int eigen_solves = 0;
 };
-Selection select(const Problem& p, const std::vector<SetFit>& singles, double chi2_0, const FitQuality& before);
+Selection select(const Problem& p, const std::vector<SetFit>& singles, const FitQuality& before);
 
 }  // namespace dynid::internal
