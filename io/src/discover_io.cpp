@@ -147,6 +147,14 @@ std::string misfit_words(const DiscoverySummary& s) {
          format_number(s.before.max_freq_error_pct, 3) + " %, mean MAC " + format_number(s.before.mean_mac, 4);
 }
 
+// The rivals, each with its ln Bayes factor over the model as given.
+std::string rivals_words(const DiscoverySummary& s) {
+  std::string r;
+  for (std::size_t k = 0; k < s.rivals.size(); ++k)
+    r += (k ? "; " : "") + s.rivals[k].description + " (ln Bayes factor " + format_number(s.rivals[k].log_evidence, 3) + ")";
+  return r.empty() ? "the other explanations scored" : r;
+}
+
 }  // namespace
 
 std::string discovery_explanation(const DiscoverySummary& s) {
@@ -168,20 +176,21 @@ std::string discovery_explanation(const DiscoverySummary& s) {
       return "The model misses something the candidates describe only in part: the best explanation, " + findings_words(s) +
              ", removes " + pct(s.explained) + " % of the misfit beyond the noise (" + fit_words(s) +
              "). An effect outside the library, or several at once, is likely.";
-    case VerdictReason::kRivals: {
-      std::string r;
-      for (std::size_t k = 0; k < s.rivals.size(); ++k)
-        r += (k ? "; " : "") + s.rivals[k].description + " (ln Bayes factor " + format_number(s.rivals[k].log_evidence, 3) + ")";
+    case VerdictReason::kRivals:
       return "The model misses something, but the data cannot tell which: the best explanation, " + findings_words(s) +
-             " (ln Bayes factor " + format_number(s.combined.log_evidence, 3) + "; " + fit_words(s) + "), fits about as well as " + r +
+             " (ln Bayes factor " + format_number(s.combined.log_evidence, 3) + "; " + fit_words(s) + "), has a probability of only " +
+             pct(s.probability) + " % against " + rivals_words(s) +
              ". More modes, or sensors at the competing sites (rotations or strains there), would decide.";
-    }
     case VerdictReason::kExplained: {
       std::string w = "Missing physics: " + findings_words(s) + ". " + fit_words(s) + "; the findings remove " + pct(s.explained) +
                       " % of the misfit beyond the noise, decisively (ln Bayes factor " + format_number(s.combined.log_evidence, 3) +
                       " over the model as given";
       if (s.recalibration.fitted) w += ", " + format_number(s.recalibration.log_evidence, 3) + " for recalibrating E and rho globally";
-      return w + ").";
+      w += ").";
+      if (!s.rivals.empty())
+        w += " Not certain: a probability of " + pct(s.probability) + " % against " + rivals_words(s) +
+             ", which fit almost as well; more modes, or sensors at the competing sites, would decide.";
+      return w;
     }
   }
   return "";
@@ -306,6 +315,7 @@ nlohmann::ordered_json discovery_json(const Case& c, const DiscoveryData& d, con
     j["steps"].push_back({{"action", a}, {"effect", st.description}, {"log_evidence", or_null(true, st.log_evidence)},
                           {"explained", st.explained}, {"max_freq_error_pct", st.max_freq_error_pct}, {"mean_mac", st.mean_mac}});
   }
+  j["probability"] = s.probability;
   j["rivals"] = nlohmann::ordered_json::array();
   for (const ScoredHypothesis& h : s.rivals)
     j["rivals"].push_back({{"kinds", h.kind}, {"description", h.description}, {"log_evidence", or_null(true, h.log_evidence)},

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <set>
 
 #include "candidates/registry.hpp"
 #include "discovery/stages.hpp"
@@ -254,11 +255,14 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
       if (scaled_norm2(p, g.residuals - own->residuals, es) > 2 * options.ambiguity) continue;
       equivalent[c].push_back(g.set[0]);
       ScoredHypothesis& h = S.findings[k];
+      h.equivalent.push_back(g.set[0]->description());
+      // A local finding's site grows by the equivalent sites; a global one (all members, or a group) keeps the
+      // site its description names (another group is an equivalent story, not a larger site).
+      if (c->global()) continue;
       for (int id : g.set[0]->site().nodes)
         if (std::find(h.site.nodes.begin(), h.site.nodes.end(), id) == h.site.nodes.end()) h.site.nodes.push_back(id);
       for (int id : g.set[0]->site().elements)
         if (std::find(h.site.elements.begin(), h.site.elements.end(), id) == h.site.elements.end()) h.site.elements.push_back(id);
-      h.equivalent.push_back(g.set[0]->description());
     }
   }
   // Whether a set of effects tells another story than the findings: an effect unlike every finding.
@@ -275,26 +279,44 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
     return false;
   };
 
-  // Rivals: complete explanations of other stories, and the recalibration, within `ambiguity` in evidence.
+  // Rivals: complete explanations of other stories (the other chains' results and the single candidates), and the
+  // recalibration, within `ambiguity` in evidence; the findings' probability against every one of them scored
+  // (and the model as given, at 0).
   const double best = S.combined.log_evidence;
-  for (const SetFit& a : sel.alternatives) {
-    if (a.set.size() > sel.fit.set.size()) continue;
-    if (log_evidence(p, a) < best - options.ambiguity || !other_story(a.set)) continue;
-    ScoredHypothesis h = score(a, 0);
+  double odds_against = std::exp(-best);
+  std::vector<const SetFit*> others;
+  for (const SetFit& a : sel.alternatives) others.push_back(&a);
+  for (const SetFit& f : singles)
+    if (f.ok && !f.at_bound) others.push_back(&f);
+  std::set<std::vector<const Candidate*>> seen;  // a set reached twice (two starts, a chain of one) counts once
+  for (const SetFit* a : others) {
+    if (a->set.size() > sel.fit.set.size() || !other_story(a->set)) continue;
+    std::vector<const Candidate*> key(a->set.begin(), a->set.end());
+    std::sort(key.begin(), key.end());
+    if (!seen.insert(key).second) continue;
+    const double le = log_evidence(p, *a);
+    odds_against += std::exp(le - best);
+    if (le < best - options.ambiguity) continue;
+    ScoredHypothesis h = score(*a, 0);
     h.kind.clear();
     h.description.clear();
-    for (const Candidate* c : a.set) {
+    for (const Candidate* c : a->set) {
       h.kind += (h.kind.empty() ? "" : "+") + c->kind();
       h.description += (h.description.empty() ? "" : "; ") + c->description();
     }
     S.rivals.push_back(std::move(h));
   }
-  if (recal.ok && !recal.at_bound && S.recalibration.log_evidence >= best - options.ambiguity)
-    S.rivals.push_back(S.recalibration);
+  if (recal.ok && !recal.at_bound) {
+    odds_against += std::exp(S.recalibration.log_evidence - best);
+    if (S.recalibration.log_evidence >= best - options.ambiguity) S.rivals.push_back(S.recalibration);
+  }
+  std::stable_sort(S.rivals.begin(), S.rivals.end(),
+                   [](const ScoredHypothesis& a, const ScoredHypothesis& b) { return a.log_evidence > b.log_evidence; });
   const double noise_floor = static_cast<double>(p.n);
   const double absolute = chi2_0 > noise_floor ? (chi2_0 - sel.fit.chi2) / (chi2_0 - noise_floor) : 1.0;
   S.explained = std::clamp(absolute, 0.0, 1.0);
-  if (!S.rivals.empty()) {
+  S.probability = 1.0 / (1.0 + odds_against);
+  if (S.probability < options.min_probability) {
     S.verdict = Verdict::kInconclusive;
     S.reason = VerdictReason::kRivals;
   } else if (absolute < options.partial) {

@@ -47,9 +47,14 @@ struct DiscoveryOptions {
   int screen_fit = 16;             ///< local candidates fitted in full after the linear screening
   int max_effects = 3;             ///< at most this many effects combined (and one parameter per two measured modes)
   /// Evidence thresholds, natural log of the Bayes factor: `decisive` for a finding and for each further effect
-  /// (5 = 150:1, "very strong" on the Kass-Raftery scale); a different explanation within `ambiguity` of the
-  /// findings makes the verdict inconclusive.
+  /// (5 = 150:1, "very strong" on the Kass-Raftery scale); explanations of another story within `ambiguity` of the
+  /// findings are reported as rivals.
   double decisive = 5.0, ambiguity = 3.0;
+  /// The findings are named (verdict missing_physics) when their posterior probability among the explanations
+  /// scored (theirs, every explored explanation of another story, the recalibration, the model as given; equal
+  /// prior odds) is at least this: more probable than all the others together. Below it the verdict is
+  /// inconclusive (reason rivals).
+  double min_probability = 0.5;
   /// A further effect must remove `further` of the misfit its predecessors leave (beyond what the best set
   /// explored leaves): a real second effect removes nearly all of it, a stand-in that absorbs the first effect's
   /// approximation of the real physics only part. An explanation that removes less than `partial` of the misfit
@@ -120,8 +125,8 @@ struct ScoredHypothesis {
   double significance = 0;         ///< smallest |theta - nominal| / std over its parameters
   std::vector<PhysicalValue> values;
   std::string finding;             ///< the candidate's own sentence (Candidate::finding)
-  /// Findings: the same kind at other sites the data cannot tell from this one (their sites are in `site` too,
-  /// after its own).
+  /// Findings: the same kind at other sites the data cannot tell from this one (a local finding's `site` holds
+  /// theirs too, after its own; a global one keeps its own).
   std::vector<std::string> equivalent;
   double max_freq_error_pct = 0, mean_mac = 0;
   bool at_bound = false;           ///< a parameter ended on a bound (the hypothesis strains to fit)
@@ -197,6 +202,9 @@ struct DiscoverySummary {
   std::vector<SelectionStep> steps;          ///< how the explanation was reached
   std::vector<ScoredHypothesis> candidates;  ///< every single candidate fitted, best first
   std::vector<ScoredHypothesis> rivals;      ///< explanations of another kind or place within `ambiguity`
+  /// The findings' posterior probability among the explanations scored (DiscoveryOptions::min_probability); 1 when
+  /// nothing else comes near, 0 when nothing was found.
+  double probability = 0;
   ScoredHypothesis recalibration;            ///< E and rho recalibrated globally (always scored)
   FitQuality before, after;
   /// Share of the model's misfit beyond the noise (chi-square above its expectation at the noise model's
