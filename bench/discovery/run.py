@@ -2,8 +2,8 @@
 """The concealed-physics benchmark in one command: generate a split, run `dynid discover` on every case, score,
 report (results.json, table.md, confusion.png, parameters.png).
 
-  run.py [--split dev|test] [--subset ci] [--limit N] [--cases DIR] [--out DIR] [--keep] [--dynid PATH]
-         [--jobs 2] [--timeout S] [--check]
+  run.py [--split dev|test] [--subset ci] [--limit N] [--cases DIR [--rescore]] [--out DIR] [--keep]
+         [--dynid PATH] [--jobs 2] [--timeout S] [--check]
 
 Each worker generates a case, runs dynid on it (one thread) and scores it, so at most --jobs dynid processes
 run at a time. dynid's failures (exit code, last line of its error output) are scored as wrong, never fatal.
@@ -59,6 +59,13 @@ def run_case(job):
                     seconds_generate=time.time() - t0, seconds_dynid=0.0)
     t1 = time.time()
     out_json, out_png = Path(folder) / "discover.json", Path(folder) / "discover.png"
+    if a.get("rescore"):   # score the result dynid wrote before (a scoring or report change), never run it
+        result = json.loads(out_json.read_text()) if out_json.exists() else None
+        sc = score.score(truth, result, None if result else "no discover.json")
+        sc.update(exit_code=None, seconds_generate=0.0, seconds_dynid=0.0,
+                  truth_effects=[e["description"] for e in truth["effects"]], dofs=truth["structure"]["dofs"],
+                  shift_pct=truth["shift_pct"], data=truth["data"])
+        return sc
     cmd = [a["dynid"], "--threads", "1", "-q", "discover", str(folder), "--json", str(out_json),
            "--plot", str(out_png), "--force"]
     result, rc = None, None
@@ -177,6 +184,16 @@ def table(rep, cases, checks, meta):
     for name, v, text, ok in checks:
         val = str(v) if isinstance(v, int) else pct(v)
         lines.append(f"| {name} | {val} | {text} | {'yes' if ok else '**no**'} |")
+    lines += ["", "## Stated probability against outcome", "",
+              "Non-null cases with verdict missing_physics, by the probability dynid states for its findings against "
+              "their rivals (JSON `probability`); a calibrated statement is right about as often as it says.", "",
+              "| stated probability | claims | mean stated | named right |", "|---|---|---|---|"]
+    claims = [c for c in cases if not c["null"] and c["verdict"] == "missing_physics" and c.get("probability") is not None]
+    for lo, hi in ((0.5, 0.7), (0.7, 0.9), (0.9, 0.99), (0.99, 1.01)):
+        b = [c for c in claims if lo <= c["probability"] < hi]
+        if b:
+            lines.append(f"| {lo:g}–{min(hi, 1):g} | {len(b)} | {pct(sum(c['probability'] for c in b) / len(b))} | "
+                         f"{pct(sum(c['named_right'] for c in b) / len(b))} |")
     lines += ["", "## Cases not right", "", "| case | truth | family | dynid said |", "|---|---|---|---|"]
     for c in cases:
         right = c["null_right"] if c["null"] else c["named_right"]
@@ -258,6 +275,8 @@ def main():
                                     "e.g. made by generate.py or kept by --keep; their data are never deleted")
     ap.add_argument("--out", help="output folder (default build/bench-discovery/<split>[-ci])")
     ap.add_argument("--keep", action="store_true", help="keep the recordings (deleted after scoring by default)")
+    ap.add_argument("--rescore", action="store_true", help="with --cases: score the discover.json each folder holds "
+                                                           "(a scoring or report change) without running dynid")
     ap.add_argument("--dynid", default=str(ROOT / "build" / "cli" / "dynid"))
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--timeout", type=float, default=600.0, help="seconds per dynid run")
@@ -269,7 +288,10 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
     if not Path(a.dynid).exists():
         sys.exit(f"dynid not found at {a.dynid} (build it, or give --dynid)")
-    opts = dict(out=str(out / "cases"), dynid=str(Path(a.dynid).resolve()), keep=a.keep, timeout=a.timeout)
+    if a.rescore and not a.cases:
+        sys.exit("--rescore needs --cases (the folders holding the discover.json to score)")
+    opts = dict(out=str(out / "cases"), dynid=str(Path(a.dynid).resolve()), keep=a.keep, timeout=a.timeout,
+                rescore=a.rescore)
     if a.cases:
         folders = sorted(p.parent for p in Path(a.cases).glob("*/truth.json"))
         jobs = [(f, None, None, opts) for f in folders]

@@ -69,6 +69,7 @@ def score(truth, result, failure=None):
     rec["verdict"] = verdict
     rec["inconclusive"] = verdict == "inconclusive"
     rec["named"] = findings[0]["kind"] if findings else verdict
+    rec["probability"] = result.get("probability")   # the findings' stated probability against their rivals
     rec["said"] = verdict + (": " + "; ".join(f["description"] for f in findings) if findings else "")
     fit = result.get("fit") or {}
     before, after = fit.get("before") or {}, fit.get("after") or {}
