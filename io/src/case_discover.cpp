@@ -227,6 +227,7 @@ void identify_recordings_for(const Case& c, std::vector<Recording> recs, Discove
   const std::string method = d.truth ? (d.method.empty() ? d.truth_test->method : d.method) : d.method;
   IdentificationOptions io = d.identify;
   if (d.truth && d.identify.band_hi_hz == 0 && d.identify.max_order == 0) io = d.truth_test->identify;
+  std::string band_words = "in the band the case gives";
   if (d.identify.band_hi_hz == 0 && !recs.empty()) {
     // One rule for every case: the band the analysis model implies for these sensors (band_from_model).
     std::vector<MeasuredDof> sensors;
@@ -238,10 +239,18 @@ void identify_recordings_for(const Case& c, std::vector<Recording> recs, Discove
     out->notes.push_back("identification band " + format_number(b.lo_hz, 4) + " to " + format_number(b.hi_hz, 4) + " Hz, from the " +
                          std::to_string(b.visible_hz.size()) + " lowest modes of the model the sensors see (" +
                          format_number(b.visible_hz.front(), 4) + " to " + format_number(b.visible_hz.back(), 4) + " Hz)");
+    band_words = "in " + format_number(b.lo_hz, 4) + " to " + format_number(b.hi_hz, 4) + " Hz, where the model has " +
+                 std::to_string(b.visible_hz.size()) + " modes the sensors see";
   }
   out->identification = identify_recordings(std::move(recs), method, io);
   out->identified = true;
   out->measured = out->identification.modal_data("identified from " + out->source);
+  const Eigen::Index found = out->measured.num_modes();
+  if (found < 2)
+    throw InputError(out->source + ": discover: identification (" + out->identification.method + ") found " + std::to_string(found) + " mode" +
+                     (found == 1 ? "" : "s") + " " + band_words + "; discovery needs at least 2. Longer records, more or "
+                     "better-placed sensors, or another band (discover: identify: band_hz: [lo, hi]) would help; "
+                     "`dynid identify` on the same files lists the rejected poles and why.");
 }
 }  // namespace
 
