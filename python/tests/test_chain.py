@@ -119,3 +119,16 @@ def test_chain_finds_the_damage(chain_python):
     e9 = next(p for p in u["parameters"] if p["name"] == "E9")
     assert abs(e9["value"] - 0.85) < 0.05 and u["converged"]
     assert chain_python["discover"]["verdict"] in ("missing_physics", "inconclusive")
+
+
+def test_discovery_probability_is_the_verdicts_rule():
+    """Real data that cannot tell the stories apart (USC cantilever: three frequencies at one sensor): the stated
+    probability is at most what the listed rivals alone leave (unlisted explanations only add odds against), the
+    verdict follows it (missing physics at >= 0.5, else inconclusive for rivals), and the prose says how sure."""
+    r = dynid.discover(dynid.load_case(str(CASES / "real-usc-cantilever")))
+    best = r["combined"]["log_evidence"]
+    bound = 1.0 / (1.0 + sum(math.exp(x["log_evidence"] - best) for x in r["rivals"]))
+    assert r["rivals"] and 0.0 < r["probability"] <= bound + 1e-12
+    assert (r["verdict"] == "missing_physics") == (r["probability"] >= 0.5)
+    if r["verdict"] == "missing_physics":
+        assert f"a probability of {round(100 * r['probability'])} % against" in r["explanation"]
