@@ -46,6 +46,7 @@ bool DiscoveryOptions::IsValid(std::string* why) const {
   if (screen_fit < 1) return fail("screen_fit must be >= 1");
   if (max_effects < 1) return fail("max_effects must be >= 1");
   if (!(decisive > 0) || !(ambiguity >= 0)) return fail("decisive must be > 0 and ambiguity >= 0");
+  if (!(min_probability >= 0 && min_probability <= 1)) return fail("min_probability must be in [0, 1]");
   if (!(further > 0 && further <= 1) || !(partial >= 0 && partial <= 1)) return fail("further must be in (0, 1], partial in [0, 1]");
   if (!(min_share >= 0 && min_share < 1) || !(model_form >= 0 && model_form < 1)) return fail("min_share and model_form must be in [0, 1)");
   if (!(form_error_frequency > 0 && form_error_frequency < 1) || !(form_error_shape > 0 && form_error_shape < 1))
@@ -114,6 +115,162 @@ void check_set_aside(const Problem& p, const ModalData& measured, const SetFit& 
 
 }  // namespace
 
+namespace {
+
+// The localization's nature and mean frequency error from the screening (locate() gives the rest).
+void screening_nature(const Problem& p, const Screening& sc, Localization* L) {
+  L->mean_frequency_error_pct = 100.0 * ((sc.model_hz - p.data.frequencies_hz).array() / p.data.frequencies_hz.array()).mean();
+  double best_k = 0, best_m = 0;
+  for (std::size_t k = 0; k < p.library.size(); ++k) {
+    if (p.library[k]->global()) continue;
+    double& b = p.library[k]->nature() == Nature::kMass ? best_m : best_k;
+    b = std::max(b, sc.drop[k]);
+  }
+  L->nature = best_m > best_k ? Nature::kMass : Nature::kStiffness;
+}
+
+// One fitted set scored: its evidence, the share of the misfit it removes (against the best explored chi-square)
+// and the significance of its k-th effect.
+ScoredHypothesis score_fit(const Problem& p, const SetFit& f, std::size_t k, double chi2_best) {
+  ScoredHypothesis h = scored(p, f, k);
+  h.log_evidence = log_evidence(p, f);
+  h.explained = explained_share(p, f, chi2_best);
+  h.significance = significance(p, f, k);
+  return h;
+}
+
+// The kinds and descriptions of a set, "+"- and "; "-joined, in the order given.
+void join_set(const std::vector<const Candidate*>& set, const std::vector<std::size_t>& order, ScoredHypothesis* h) {
+  h->kind.clear();
+  h->description.clear();
+  for (std::size_t k : order) {
+    h->kind += (h->kind.empty() ? "" : "+") + set[k]->kind();
+    h->description += (h->description.empty() ? "" : "; ") + set[k]->description();
+  }
+}
+
+// The findings, most important first (by the evidence lost without each), each with the values fitted in the
+// combination, and the combination scored as a whole. Returns the order.
+std::vector<std::size_t> report_findings(const Problem& p, const Selection& sel, DiscoverySummary* S) {
+  std::vector<std::size_t> order(sel.fit.set.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return sel.importance[a] > sel.importance[b]; });
+  for (std::size_t k : order) {
+    ScoredHypothesis h = score_fit(p, sel.fit, k, sel.chi2_best);
+    h.log_evidence = sel.importance[k];
+    S->findings.push_back(std::move(h));
+  }
+  S->combined = score_fit(p, sel.fit, 0, sel.chi2_best);
+  join_set(sel.fit.set, order, &S->combined);
+  S->combined.parameters = sel.fit.parameters();
+  S->combined.values.clear();
+  S->combined.finding.clear();
+  S->combined.significance = S->findings.back().significance;
+  return order;
+}
+
+using Equivalents = std::map<const Candidate*, std::vector<const Candidate*>>;
+
+// Equivalent sites: candidates of a finding's kind elsewhere whose single fits predict the same data (their
+// whitened predictions differ by less than the data resolve, 2 x ambiguity in chi-square at the evidence's
+// noise) with about the same evidence. The data cannot tell them apart (a spring anywhere along an axially
+// rigid floor beam): the finding names them all, its own site first.
+Equivalents name_equivalent_sites(const Problem& p, const Selection& sel, const std::vector<SetFit>& singles,
+                                  const std::vector<std::size_t>& order, DiscoverySummary* S) {
+  Equivalents equivalent;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const Candidate* c = sel.fit.set[order[k]];
+    const auto own = std::find_if(singles.begin(), singles.end(), [&](const SetFit& f) { return f.ok && f.set[0] == c; });
+    if (own == singles.end()) continue;
+    const double le = log_evidence(p, *own);
+    const ErrorScale es = error_scale(p, *own);
+    for (const SetFit& g : singles) {
+      if (!g.ok || g.at_bound || g.set[0] == c || g.set[0]->kind() != c->kind()) continue;
+      if (log_evidence(p, g) < le - p.options.ambiguity) continue;
+      if (scaled_norm2(p, g.residuals - own->residuals, es) > 2 * p.options.ambiguity) continue;
+      equivalent[c].push_back(g.set[0]);
+      ScoredHypothesis& h = S->findings[k];
+      h.equivalent.push_back(g.set[0]->description());
+      // A local finding's site grows by the equivalent sites; a global one (all members, or a group) keeps the
+      // site its description names (another group is an equivalent story, not a larger site).
+      if (c->global()) continue;
+      for (int id : g.set[0]->site().nodes)
+        if (std::find(h.site.nodes.begin(), h.site.nodes.end(), id) == h.site.nodes.end()) h.site.nodes.push_back(id);
+      for (int id : g.set[0]->site().elements)
+        if (std::find(h.site.elements.begin(), h.site.elements.end(), id) == h.site.elements.end()) h.site.elements.push_back(id);
+    }
+  }
+  return equivalent;
+}
+
+// Rivals: complete explanations of other stories (the other chains' results and the single candidates), and the
+// recalibration, within `ambiguity` in evidence; the findings' probability against every one of them scored
+// (and the model as given, at 0).
+void weigh_rivals(const Problem& p, const Selection& sel, const std::vector<SetFit>& singles, const SetFit& recal,
+                  const Equivalents& equivalent, DiscoverySummary* S) {
+  // Whether a set of effects tells another story than the findings: an effect unlike every finding.
+  auto like = [&](const Candidate* x, const Candidate* f) {
+    if (x == f || same_story(*p.model, *x, *f)) return true;
+    const auto it = equivalent.find(f);
+    return it != equivalent.end() && std::find(it->second.begin(), it->second.end(), x) != it->second.end();
+  };
+  auto other_story = [&](const std::vector<const Candidate*>& a) {
+    for (const Candidate* x : a)
+      if (std::none_of(sel.fit.set.begin(), sel.fit.set.end(), [&](const Candidate* f) { return like(x, f); })) return true;
+    for (const Candidate* f : sel.fit.set)
+      if (std::none_of(a.begin(), a.end(), [&](const Candidate* x) { return like(x, f); })) return true;
+    return false;
+  };
+  const double best = S->combined.log_evidence;
+  double odds_against = std::exp(-best);
+  std::vector<const SetFit*> others;
+  for (const SetFit& a : sel.alternatives) others.push_back(&a);
+  for (const SetFit& f : singles)
+    if (f.ok && !f.at_bound) others.push_back(&f);
+  std::set<std::vector<const Candidate*>> seen;  // a set reached twice (two starts, a chain of one) counts once
+  for (const SetFit* a : others) {
+    if (a->set.size() > sel.fit.set.size() || !other_story(a->set)) continue;
+    std::vector<const Candidate*> key(a->set.begin(), a->set.end());
+    std::sort(key.begin(), key.end());
+    if (!seen.insert(key).second) continue;
+    const double le = log_evidence(p, *a);
+    odds_against += std::exp(le - best);
+    if (le < best - p.options.ambiguity) continue;
+    ScoredHypothesis h = score_fit(p, *a, 0, sel.chi2_best);
+    std::vector<std::size_t> all(a->set.size());
+    std::iota(all.begin(), all.end(), 0);
+    join_set(a->set, all, &h);
+    S->rivals.push_back(std::move(h));
+  }
+  if (recal.ok && !recal.at_bound) {
+    odds_against += std::exp(S->recalibration.log_evidence - best);
+    if (S->recalibration.log_evidence >= best - p.options.ambiguity) S->rivals.push_back(S->recalibration);
+  }
+  std::stable_sort(S->rivals.begin(), S->rivals.end(),
+                   [](const ScoredHypothesis& a, const ScoredHypothesis& b) { return a.log_evidence > b.log_evidence; });
+  S->probability = 1.0 / (1.0 + odds_against);
+}
+
+// The verdict on an explanation: missing physics when it is the most probable story and removes at least
+// `partial` of the misfit beyond the noise.
+void decide(const Problem& p, const Selection& sel, DiscoverySummary* S) {
+  const double noise_floor = static_cast<double>(p.n);
+  const double absolute = p.chi2_0 > noise_floor ? (p.chi2_0 - sel.fit.chi2) / (p.chi2_0 - noise_floor) : 1.0;
+  S->explained = std::clamp(absolute, 0.0, 1.0);
+  if (S->probability < p.options.min_probability) {
+    S->verdict = Verdict::kInconclusive;
+    S->reason = VerdictReason::kRivals;
+  } else if (absolute < p.options.partial) {
+    S->verdict = Verdict::kInconclusive;
+    S->reason = VerdictReason::kPartlyExplained;
+  } else {
+    S->verdict = Verdict::kMissingPhysics;
+    S->reason = VerdictReason::kExplained;
+  }
+}
+
+}  // namespace
+
 DiscoverySummary discover(const Model& model, const ModalData& measured, const DiscoveryOptions& options,
                           std::vector<std::unique_ptr<Candidate>> extra) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -136,7 +293,6 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   // ---- locate and screen ----
   S.localization = locate(p);
   const Screening sc = screen(p);
-  p.n = 0;
   p.n = p.modes * (1 + static_cast<int>(p.data.dofs.size()));
   S.data = p.n;
   S.eigen_solves = 2;
@@ -149,17 +305,7 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   for (std::size_t k = 0; k < sc.paired.size(); ++k) forced0[k] = !sc.paired[k];
   S.before = quality_of(p, sc.model_hz, sc.mac, chi2_0, forced0);
   S.after = S.before;
-  {
-    Localization& L = S.localization;
-    L.mean_frequency_error_pct = 100.0 * ((sc.model_hz - p.data.frequencies_hz).array() / p.data.frequencies_hz.array()).mean();
-    double best_k = 0, best_m = 0;
-    for (std::size_t k = 0; k < p.library.size(); ++k) {
-      if (p.library[k]->global()) continue;
-      double& b = p.library[k]->nature() == Nature::kMass ? best_m : best_k;
-      b = std::max(b, sc.drop[k]);
-    }
-    L.nature = best_m > best_k ? Nature::kMass : Nature::kStiffness;
-  }
+  screening_nature(p, sc, &S.localization);
   const bool consistent = sc.chi2_frequency <= chi2_quantile(p.modes, 0.5 * options.consistency_level) &&
                           chi2_0 - sc.chi2_frequency <= chi2_quantile(std::max(1, p.n - p.modes), 0.5 * options.consistency_level);
 
@@ -174,6 +320,7 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   for (const SetFit& f : singles) S.eigen_solves += f.evaluations;
   S.eigen_solves += recal.evaluations;
 
+  // ---- grow and prune the explanation ----
   Selection sel;
   if (!consistent) sel = select(p, singles, S.before);
   else {
@@ -187,21 +334,14 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
     S.noise_scale_frequency = es.frequency;
     S.noise_scale_shape = es.shape;
   }
-  auto score = [&](const SetFit& f, std::size_t k) {
-    ScoredHypothesis h = scored(p, f, k);
-    h.log_evidence = log_evidence(p, f);
-    h.explained = explained_share(p, f, sel.chi2_best);
-    h.significance = significance(p, f, k);
-    return h;
-  };
   for (std::size_t k = 0; k < list.size(); ++k) {
-    ScoredHypothesis h = score(singles[k], 0);
+    ScoredHypothesis h = score_fit(p, singles[k], 0, sel.chi2_best);
     h.screening = sc.drop[list[k]];
     S.candidates.push_back(std::move(h));
   }
   std::stable_sort(S.candidates.begin(), S.candidates.end(),
                    [](const ScoredHypothesis& a, const ScoredHypothesis& b) { return a.log_evidence > b.log_evidence; });
-  S.recalibration = score(recal, 0);
+  S.recalibration = score_fit(p, recal, 0, sel.chi2_best);
 
   // ---- decide ----
   if (consistent) {
@@ -214,118 +354,13 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
     S.reason = VerdictReason::kNothingDecisive;
     return finish();
   }
-  // The findings, most important first, each with the values fitted in the combination.
-  std::vector<std::size_t> order(sel.fit.set.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return sel.importance[a] > sel.importance[b]; });
-  for (std::size_t k : order) {
-    ScoredHypothesis h = score(sel.fit, k);
-    h.log_evidence = sel.importance[k];
-    S.findings.push_back(std::move(h));
-  }
-  S.combined = score(sel.fit, 0);
-  S.combined.kind.clear();
-  S.combined.description.clear();
-  for (std::size_t k : order) {
-    S.combined.kind += (S.combined.kind.empty() ? "" : "+") + sel.fit.set[k]->kind();
-    S.combined.description += (S.combined.description.empty() ? "" : "; ") + sel.fit.set[k]->description();
-  }
-  S.combined.parameters = sel.fit.parameters();
-  S.combined.values.clear();
-  S.combined.finding.clear();
-  S.combined.significance = S.findings.back().significance;
+  const std::vector<std::size_t> order = report_findings(p, sel, &S);
   S.steps = sel.steps;
   S.after = sel.fit.quality;
   check_set_aside(p, measured, sel.fit, &S.set_aside);
-
-  // Equivalent sites: candidates of a finding's kind elsewhere whose single fits predict the same data (their
-  // whitened predictions differ by less than the data resolve, 2 x ambiguity in chi-square at the evidence's
-  // noise) with about the same evidence. The data cannot tell them apart (a spring anywhere along an axially
-  // rigid floor beam): the finding names them all, its own site first.
-  std::map<const Candidate*, std::vector<const Candidate*>> equivalent;
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    const Candidate* c = sel.fit.set[order[k]];
-    const auto own = std::find_if(singles.begin(), singles.end(), [&](const SetFit& f) { return f.ok && f.set[0] == c; });
-    if (own == singles.end()) continue;
-    const double le = log_evidence(p, *own);
-    const ErrorScale es = error_scale(p, *own);
-    for (const SetFit& g : singles) {
-      if (!g.ok || g.at_bound || g.set[0] == c || g.set[0]->kind() != c->kind()) continue;
-      if (log_evidence(p, g) < le - options.ambiguity) continue;
-      if (scaled_norm2(p, g.residuals - own->residuals, es) > 2 * options.ambiguity) continue;
-      equivalent[c].push_back(g.set[0]);
-      ScoredHypothesis& h = S.findings[k];
-      h.equivalent.push_back(g.set[0]->description());
-      // A local finding's site grows by the equivalent sites; a global one (all members, or a group) keeps the
-      // site its description names (another group is an equivalent story, not a larger site).
-      if (c->global()) continue;
-      for (int id : g.set[0]->site().nodes)
-        if (std::find(h.site.nodes.begin(), h.site.nodes.end(), id) == h.site.nodes.end()) h.site.nodes.push_back(id);
-      for (int id : g.set[0]->site().elements)
-        if (std::find(h.site.elements.begin(), h.site.elements.end(), id) == h.site.elements.end()) h.site.elements.push_back(id);
-    }
-  }
-  // Whether a set of effects tells another story than the findings: an effect unlike every finding.
-  auto like = [&](const Candidate* x, const Candidate* f) {
-    if (x == f || same_story(model, *x, *f)) return true;
-    const auto it = equivalent.find(f);
-    return it != equivalent.end() && std::find(it->second.begin(), it->second.end(), x) != it->second.end();
-  };
-  auto other_story = [&](const std::vector<const Candidate*>& a) {
-    for (const Candidate* x : a)
-      if (std::none_of(sel.fit.set.begin(), sel.fit.set.end(), [&](const Candidate* f) { return like(x, f); })) return true;
-    for (const Candidate* f : sel.fit.set)
-      if (std::none_of(a.begin(), a.end(), [&](const Candidate* x) { return like(x, f); })) return true;
-    return false;
-  };
-
-  // Rivals: complete explanations of other stories (the other chains' results and the single candidates), and the
-  // recalibration, within `ambiguity` in evidence; the findings' probability against every one of them scored
-  // (and the model as given, at 0).
-  const double best = S.combined.log_evidence;
-  double odds_against = std::exp(-best);
-  std::vector<const SetFit*> others;
-  for (const SetFit& a : sel.alternatives) others.push_back(&a);
-  for (const SetFit& f : singles)
-    if (f.ok && !f.at_bound) others.push_back(&f);
-  std::set<std::vector<const Candidate*>> seen;  // a set reached twice (two starts, a chain of one) counts once
-  for (const SetFit* a : others) {
-    if (a->set.size() > sel.fit.set.size() || !other_story(a->set)) continue;
-    std::vector<const Candidate*> key(a->set.begin(), a->set.end());
-    std::sort(key.begin(), key.end());
-    if (!seen.insert(key).second) continue;
-    const double le = log_evidence(p, *a);
-    odds_against += std::exp(le - best);
-    if (le < best - options.ambiguity) continue;
-    ScoredHypothesis h = score(*a, 0);
-    h.kind.clear();
-    h.description.clear();
-    for (const Candidate* c : a->set) {
-      h.kind += (h.kind.empty() ? "" : "+") + c->kind();
-      h.description += (h.description.empty() ? "" : "; ") + c->description();
-    }
-    S.rivals.push_back(std::move(h));
-  }
-  if (recal.ok && !recal.at_bound) {
-    odds_against += std::exp(S.recalibration.log_evidence - best);
-    if (S.recalibration.log_evidence >= best - options.ambiguity) S.rivals.push_back(S.recalibration);
-  }
-  std::stable_sort(S.rivals.begin(), S.rivals.end(),
-                   [](const ScoredHypothesis& a, const ScoredHypothesis& b) { return a.log_evidence > b.log_evidence; });
-  const double noise_floor = static_cast<double>(p.n);
-  const double absolute = chi2_0 > noise_floor ? (chi2_0 - sel.fit.chi2) / (chi2_0 - noise_floor) : 1.0;
-  S.explained = std::clamp(absolute, 0.0, 1.0);
-  S.probability = 1.0 / (1.0 + odds_against);
-  if (S.probability < options.min_probability) {
-    S.verdict = Verdict::kInconclusive;
-    S.reason = VerdictReason::kRivals;
-  } else if (absolute < options.partial) {
-    S.verdict = Verdict::kInconclusive;
-    S.reason = VerdictReason::kPartlyExplained;
-  } else {
-    S.verdict = Verdict::kMissingPhysics;
-    S.reason = VerdictReason::kExplained;
-  }
+  const Equivalents equivalent = name_equivalent_sites(p, sel, singles, order, &S);
+  weigh_rivals(p, sel, singles, recal, equivalent, &S);
+  decide(p, sel, &S);
   return finish();
 }
 
