@@ -118,7 +118,7 @@ plot::Figure summary_figure(const Case& c, const Model& model, const DetectSumma
 
 int run_detect(const DetectArgs& a, const GlobalOptions& g) {
   set_threads(g.threads);
-  const Case c = load_case(a.case_path);
+  const Case c = load_case(a.case_path, g.limits);
   require_section(c, c.detect.has_value(), "detect");
   const DetectSpec& d = *c.detect;
   const Model& model = c.model;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "blas_kernels.hpp"
 #include "commands.hpp"
 #include "dynid/engine/model_fit.hpp"
 #include "dynid/io/case_file.hpp"
@@ -85,9 +86,11 @@ plot::Figure update_figure(const Case& c, const ParametricModel& pm, const Updat
 
 int run_update(const UpdateArgs& a, const GlobalOptions& g) {
   set_threads(g.threads);
-  const Case c = load_case(a.case_path);
+  const Case c = load_case(a.case_path, g.limits);
   require_section(c, c.update.has_value(), "update");
   const UpdateSpec& u = *c.update;
+  // OpenBLAS on one thread where the threads work on independent tasks (the starts of a global search), whose
+  // solves would otherwise oversubscribe the cores.
   if (u.multistart) set_blas_threads(1);
   Progress progress(!g.quiet);
   progress.update("updating", -1);

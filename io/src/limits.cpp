@@ -5,11 +5,6 @@
 
 namespace dynid {
 
-ReaderLimits& reader_limits() {
-  static ReaderLimits limits;
-  return limits;
-}
-
 std::string limit_text(double value) {
   const double e = std::log10(value);
   if (value >= 1000 && std::abs(e - std::round(e)) < 1e-12) return "10^" + std::to_string(std::lround(e));
