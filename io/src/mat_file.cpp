@@ -15,6 +15,7 @@
 #include "dynid/io/limits.hpp"
 #include "dynid/io/modal_data_io.hpp"
 #include "dynid/mesh/error.hpp"
+#include "internal/text_util.hpp"
 
 namespace dynid {
 
@@ -107,11 +108,7 @@ double element(const void* p, matio_types t, std::size_t k) {
   }
 }
 
-std::string int_text(double v) {
-  char b[64];
-  std::snprintf(b, sizeof b, "%.17g", v);
-  return b;
-}
+std::string int_text(double v) { return internal::format_number(v, 17); }
 
 }  // namespace
 
