@@ -3,8 +3,8 @@
 #include <benchmark/benchmark.h>
 
 #include "bench_common.hpp"
+#include "blas_kernels.hpp"
 #include "dynid/engine/modal.hpp"
-#include "dynid/solvers/blas.hpp"
 
 namespace {
 
@@ -39,7 +39,7 @@ BENCHMARK(BM_Eigen20_3D_Generalized)->Arg(6)->Arg(12)->Unit(benchmark::kMillisec
 }  // namespace
 
 int main(int argc, char** argv) {
-  dynid::ensure_blas_kernels(argv);
+  dynid::cli::ensure_blas_kernels(argv);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

@@ -10,14 +10,14 @@
 #include <string>
 
 #include "bench_common.hpp"
+#include "blas_kernels.hpp"
 #include "dynid/engine/detect.hpp"
-#include "dynid/solvers/blas.hpp"
 
 using Clock = std::chrono::steady_clock;
 static double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 int main(int argc, char** argv) {
-  dynid::ensure_blas_kernels(argv);
+  dynid::cli::ensure_blas_kernels(argv);
   int bays = 12, stories = 14, div = 4;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];

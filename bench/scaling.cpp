@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "bench_common.hpp"
+#include "blas_kernels.hpp"
 #include "dynid/engine/modal.hpp"
 #include "dynid/io/matrix_market.hpp"
 #include "dynid/mesh/generators.hpp"
@@ -160,7 +161,7 @@ double MaxRelDiff(const json& a, const json& b) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  dynid::ensure_blas_kernels(argv);  // children and peers inherit the same BLAS kernels
+  dynid::cli::ensure_blas_kernels(argv);  // children and peers inherit the same BLAS kernels
   std::vector<Spec> specs = {
       {"2D frame 10x10, div 10", false, 10, 10, 0, 10},
       {"2D frame 30x30, div 12", false, 30, 30, 0, 12},

@@ -10,14 +10,14 @@
 #include <random>
 
 #include "bench_common.hpp"
+#include "blas_kernels.hpp"
 #include "dynid/engine/model_fit.hpp"
-#include "dynid/solvers/blas.hpp"
 
 using Clock = std::chrono::steady_clock;
 static double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 int main(int argc, char** argv) {
-  dynid::ensure_blas_kernels(argv);
+  dynid::cli::ensure_blas_kernels(argv);
   dynid::Frame3DSpec f;
   f.bays_x = f.bays_y = argc > 1 ? std::atoi(argv[1]) : 12;
   f.stories = argc > 2 ? std::atoi(argv[2]) : 14;

@@ -7,8 +7,8 @@
 #include "commands.hpp"
 #include "dynid/engine/detect.hpp"
 #include "dynid/io/case_file.hpp"
+#include "dynid/io/figures.hpp"
 #include "dynid/io/modal_data_io.hpp"
-#include "dynid/io/model_plots.hpp"
 #include "dynid/io/output.hpp"
 #include "dynid/io/plot.hpp"
 #include "dynid/io/results_json.hpp"
@@ -24,101 +24,9 @@ struct DetectArgs {
   bool study = false, force = false;
 };
 
-plot::Figure summary_figure(const Case& c, const Model& model, const DetectSummary& S) {
-  plot::Figure f;
-  f.title = "dynid detect: " + c.name;
-  f.rows = 3;
-  f.height = 1300;
-  // Per DOF: the pseudo residual force (log), DOFs of flagged elements highlighted.
-  std::vector<int> flagged_nodes;
-  for (const ElementScore& e : S.elements)
-    if (e.flagged) {
-      const auto& en = model.element_nodes(model.element_index(e.element));
-      for (int q = 0; q < model.elements()[model.element_index(e.element)].num_nodes; ++q)
-        flagged_nodes.push_back(model.nodes()[en[q]].id);
-    }
-  plot::Panel p1;
-  p1.title = S.full_dofs ? "Pseudo residual force per DOF (eq. 7-8)" : "Pseudo residual per measured DOF (SEREP)";
-  p1.ylabel = "|r| (geometric mean over modes)";
-  p1.log_y = true;
-  plot::Series in, out;
-  in.label = "DOFs of flagged elements";
-  out.label = "other DOFs";
-  in.kind = out.kind = plot::Kind::kStems;
-  in.color = 3;
-  out.color = 0;
-  for (std::size_t r = 0; r < S.dofs.size(); ++r) {
-    const bool hit = std::find(flagged_nodes.begin(), flagged_nodes.end(), S.dofs[r].node) != flagged_nodes.end();
-    plot::Series& s = hit ? in : out;
-    s.x.push_back(static_cast<double>(r + 1));
-    s.y.push_back(S.delta_pseudo[r]);
-    p1.xticks.push_back({static_cast<double>(r + 1), to_string(S.dofs[r])});
-  }
-  p1.series = {out, in};
-  // Per element: the paper's mapping (log) and dynid's localization.
-  plot::Panel p2, p3;
-  p2.title = "Pseudo residual force mapped to elements (paper)";
-  p2.ylabel = "element score";
-  p2.log_y = true;
-  p3.title = S.full_dofs ? "dynid: share each element explains alone" : "dynid: probability the element alone changed";
-  p3.ylabel = S.full_dofs ? "explained fraction" : "probability";
-  p3.xlabel = "element id";
-  plot::Series a2, b2, a3, b3;
-  a2.kind = b2.kind = a3.kind = b3.kind = plot::Kind::kBars;
-  a2.color = a3.color = 0;
-  b2.color = b3.color = 3;
-  b2.label = b3.label = "flagged";
-  for (const ElementScore& e : S.elements) {
-    (e.flagged ? b2 : a2).x.push_back(e.element);
-    (e.flagged ? b2 : a2).y.push_back(std::isnan(e.pseudo) ? 0.0 : e.pseudo);
-    (e.flagged ? b3 : a3).x.push_back(e.element);
-    (e.flagged ? b3 : a3).y.push_back(e.probability);
-  }
-  p2.series = {a2, b2};
-  p3.series = {a3, b3};
-  // The same localization as a map on the structure.
-  std::vector<std::pair<int, double>> values;
-  std::vector<int> hits;
-  for (const ElementScore& e : S.elements) {
-    values.emplace_back(e.element, e.probability);
-    if (e.flagged) hits.push_back(e.element);
-  }
-  plot::Panel p4 = plot::element_map_panel(model, values, hits, std::string("Localization on the structure (width: ") +
-                                                                     (S.full_dofs ? "share" : "probability") + ")");
-  // Frequencies and MAC of the paired modes: the model (reference state) against the changed structure.
-  plot::Panel p5, p6;
-  p5.title = "Frequency change per mode (changed vs model)";
-  p5.ylabel = "change [%]";
-  p5.xlabel = "mode";
-  p6.title = "MAC per mode (changed vs model)";
-  p6.ylabel = "MAC";
-  p6.xlabel = "mode";
-  plot::Series df, mac;
-  df.kind = plot::Kind::kBars;
-  mac.kind = plot::Kind::kLineMarkers;
-  df.color = mac.color = 0;
-  for (Eigen::Index k = 0; k < S.model_hz.size() && k < S.changed_hz.size(); ++k) {
-    df.x.push_back(static_cast<double>(k + 1));
-    df.y.push_back(100.0 * (S.changed_hz[k] / S.model_hz[k] - 1.0));
-    if (k < S.mac.size()) {
-      mac.x.push_back(static_cast<double>(k + 1));
-      mac.y.push_back(S.mac[k]);
-    }
-  }
-  p5.series = {df};
-  p6.series = {mac};
-  p5.legend = p6.legend = false;
-  f.rows = 3;
-  f.cols = 2;
-  f.width = 1800;
-  f.height = 1700;
-  f.panels = {p1, p4, p2, p3, p5, p6};
-  return f;
-}
-
 int run_detect(const DetectArgs& a, const GlobalOptions& g) {
   set_threads(g.threads);
-  const Case c = load_case(a.case_path);
+  const Case c = load_case(a.case_path, g.limits);
   require_section(c, c.detect.has_value(), "detect");
   const DetectSpec& d = *c.detect;
   const Model& model = c.model;
@@ -182,9 +90,9 @@ int run_detect(const DetectArgs& a, const GlobalOptions& g) {
   if (!a.json.empty()) {
     write_file_atomic(a.json, detect_json(c.name, S).dump(1) + "\n", a.force);
     const std::string png = a.plot.empty() ? std::filesystem::path(a.json).replace_extension(".png").string() : a.plot;
-    plot::save(summary_figure(c, model, S), png, a.force);
+    plot::save(plot::detect_figure(c, S), png, a.force);
   } else if (!a.plot.empty()) {
-    plot::save(summary_figure(c, model, S), a.plot, a.force);
+    plot::save(plot::detect_figure(c, S), a.plot, a.force);
   }
   return 0;
 }

@@ -57,7 +57,7 @@ void print_summary(const Case& c, const DiscoveryData& d, const DiscoverySummary
 
 int run_discover(const DiscoverArgs& a, const GlobalOptions& g) {
   set_threads(g.threads);
-  const Case c = load_case(a.case_path);
+  const Case c = load_case(a.case_path, g.limits);
   require_section(c, c.discover.has_value(), "discover");
   const DiscoverSpec& spec = *c.discover;
   const int seeds = a.seeds > 0 ? a.seeds : spec.seeds;

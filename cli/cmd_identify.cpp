@@ -125,6 +125,7 @@ int run_identify(const IdentifyArgs& a, const GlobalOptions& g) {
   if (!io.IsValid(&why)) throw InputError("identify: " + why);
 
   TestSetOptions to;
+  to.limits = g.limits;
   to.sample_rate_hz = a.fs;
   if (a.frf_text || a.as == "frf") to.kind = TableKind::kFrf;
   else if (a.as == "time") to.kind = TableKind::kTimeHistory;
@@ -205,7 +206,7 @@ struct SimulateArgs {
 /// Writes the recordings (one file per hit location); their paths go to `written_out` if not null.
 int run_simulate(const SimulateArgs& a, const GlobalOptions& g, std::vector<std::string>* written_out = nullptr) {
   set_threads(g.threads);
-  const Case c = load_case(a.case_path);
+  const Case c = load_case(a.case_path, g.limits);
   require_section(c, c.test.has_value(), "test");
   const TestSpec& t = *c.test;
   Progress progress(!g.quiet);
@@ -258,7 +259,7 @@ int run_simulate(const SimulateArgs& a, const GlobalOptions& g, std::vector<std:
 }  // namespace
 
 int test_step(const std::string& case_path, const std::string& dir, bool force, const GlobalOptions& g) {
-  const Case c = load_case(case_path);
+  const Case c = load_case(case_path, g.limits);
   require_section(c, c.test.has_value(), "test");
   const std::string uff = (fs::path(dir) / "test.uff").string();
   IdentifyArgs a;  // identifies exactly the files simulate-test wrote (test.uff, or test-<input>.uff per hit)

@@ -106,8 +106,8 @@ void print_frf_table(const std::string& path, const TextTable& t) {
              t.columns.cols() > 2 ? "s" : "", t.dx, n, n ? t.x[0] : 0.0, n ? t.x[n - 1] : 0.0);
 }
 
-int info_file(const std::string& path, const InfoArgs& a, std::vector<TestData>* read) {
-  TestData d = read_test_data(path, a.fs);
+int info_file(const std::string& path, const InfoArgs& a, const GlobalOptions& g, std::vector<TestData>* read) {
+  TestData d = read_test_data(path, a.fs, TableKind::kAuto, g.limits);
   switch (d.kind) {
     case TestData::Kind::kUff: print_uff(d.uff); break;
     case TestData::Kind::kTimeHistory: print_recording(path, d.recording); break;
@@ -149,7 +149,7 @@ void register_info(CLI::App& app, GlobalOptions& g) {
     std::vector<std::string> paths;
     for (const std::string& f : a->files) {
       const std::size_t before = read.size();
-      rc = std::max(rc, run_guarded("info", [&] { return info_file(f, *a, &read); }));
+      rc = std::max(rc, run_guarded("info", [&] { return info_file(f, *a, g, &read); }));
       if (read.size() > before) paths.push_back(f);
     }
     // The grouping only when every file was read and they hold test data (not only geometry or modes).

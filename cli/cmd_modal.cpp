@@ -26,7 +26,7 @@ struct ModalArgs {
 
 int run_modal(const ModalArgs& a, const GlobalOptions& g) {
   set_threads(g.threads);
-  Case c = load_case(a.case_path);
+  Case c = load_case(a.case_path, g.limits);
   for (const std::string& w : c.model.warnings())
     if (!g.quiet) fmt::print(stderr, "dynid modal: warning: {}: {}\n", c.path, w);
   for (const std::string& n : c.notes)
@@ -100,7 +100,7 @@ void register_modal(CLI::App& app, GlobalOptions& g) {
   ex->add_flag("--force", x->force, "Overwrite existing files");
   ex->callback([x, &g]() {
     g.exit_code = run_guarded("export-matrices", [&] {
-      const Case c = load_case(x->case_path);
+      const Case c = load_case(x->case_path, g.limits);
       const auto paths = write_matrix_model(c.model, x->dir, x->force);
       if (!g.quiet) {
         fmt::print("dynid export-matrices: {} ({} DOFs, {} elements) -> {}\n", c.name, c.model.num_dofs(),

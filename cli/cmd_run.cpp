@@ -33,7 +33,7 @@ int write_report(const std::string& dir, const std::string& file, bool force, co
 }
 
 int run_case(const RunArgs& a, const GlobalOptions& g) {
-  const Case c = load_case(a.case_path);  // errors in the case file stop here, before anything is written
+  const Case c = load_case(a.case_path, g.limits);  // errors in the case file stop here, before anything is written
   const std::string dir = a.out.empty() ? c.name + "-results" : a.out;
   using Step = int (*)(const std::string&, const std::string&, const std::string&, bool, const GlobalOptions&);
   std::vector<std::pair<std::string, Step>> steps = {{"modal", modal_step}};

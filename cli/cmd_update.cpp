@@ -4,9 +4,11 @@
 #include <cmath>
 #include <filesystem>
 
+#include "blas_kernels.hpp"
 #include "commands.hpp"
 #include "dynid/engine/model_fit.hpp"
 #include "dynid/io/case_file.hpp"
+#include "dynid/io/figures.hpp"
 #include "dynid/io/modal_data_io.hpp"
 #include "dynid/io/output.hpp"
 #include "dynid/io/plot.hpp"
@@ -23,71 +25,13 @@ struct UpdateArgs {
   bool force = false;
 };
 
-plot::Figure update_figure(const Case& c, const ParametricModel& pm, const UpdateSpec& u, const FitSummary& f) {
-  plot::Figure fig;
-  fig.title = "dynid update: " + c.name + " (objective " + std::string(fit_objective_name(u.options.objective)) + ")";
-  fig.rows = 3;
-  fig.height = 1300;
-  plot::Panel p1, p2, p3;
-  p1.title = "Frequency error against the measured modes";
-  p1.ylabel = "frequency error [%]";
-  p1.xlabel = "measured mode";
-  plot::Series s0, s1;
-  s0.label = "initial model";
-  s1.label = "updated model";
-  s0.kind = s1.kind = plot::Kind::kBars;
-  s0.bar_width = s1.bar_width = 0.35;
-  s0.color = 1;
-  s1.color = 0;
-  s0.dx = -0.2;
-  s1.dx = 0.2;
-  for (Eigen::Index k = 0; k < f.measured_hz.size(); ++k) {
-    s0.x.push_back(k + 1);
-    s1.x.push_back(k + 1);
-    s0.y.push_back(100 * (f.initial_hz[k] - f.measured_hz[k]) / f.measured_hz[k]);
-    s1.y.push_back(100 * (f.final_hz[k] - f.measured_hz[k]) / f.measured_hz[k]);
-  }
-  p1.series = {s0, s1};
-  p1.hlines = {{0.0, ""}};
-  p2.title = "MAC of the paired modes";
-  p2.ylabel = "MAC";
-  p2.xlabel = "measured mode";
-  plot::Series m0 = s0, m1 = s1;
-  m0.y.clear();
-  m1.y.clear();
-  for (Eigen::Index k = 0; k < f.measured_hz.size(); ++k) {
-    m0.y.push_back(f.initial_mac[k]);
-    m1.y.push_back(f.final_mac[k]);
-  }
-  p2.series = {m0, m1};
-  p2.ymin = 0;
-  p2.ymax = 1.05;
-  p3.title = "Parameters (updated value with one standard deviation)";
-  p3.ylabel = "value (factor 1 = nominal)";
-  plot::Series v0, v1;
-  v0.label = "initial";
-  v1.label = "updated";
-  v0.kind = v1.kind = plot::Kind::kMarkers;
-  v0.color = 1;
-  v1.color = 0;
-  for (int p = 0; p < pm.num_parameters(); ++p) {
-    v0.x.push_back(p + 1);
-    v1.x.push_back(p + 1);
-    v0.y.push_back(u.initial[p]);
-    v1.y.push_back(f.theta[p]);
-    v1.yerr.push_back(f.stddev[p]);
-    p3.xticks.push_back({static_cast<double>(p + 1), pm.parameter(p).name});
-  }
-  p3.series = {v0, v1};
-  fig.panels = {p1, p2, p3};
-  return fig;
-}
-
 int run_update(const UpdateArgs& a, const GlobalOptions& g) {
   set_threads(g.threads);
-  const Case c = load_case(a.case_path);
+  const Case c = load_case(a.case_path, g.limits);
   require_section(c, c.update.has_value(), "update");
   const UpdateSpec& u = *c.update;
+  // OpenBLAS on one thread where the threads work on independent tasks (the starts of a global search), whose
+  // solves would otherwise oversubscribe the cores.
   if (u.multistart) set_blas_threads(1);
   Progress progress(!g.quiet);
   progress.update("updating", -1);
@@ -132,9 +76,9 @@ int run_update(const UpdateArgs& a, const GlobalOptions& g) {
   if (!a.json.empty()) {
     write_file_atomic(a.json, update_json(c.name, pm, u, f, run.search ? &*run.search : nullptr).dump(1) + "\n", a.force);
     const std::string png = a.plot.empty() ? std::filesystem::path(a.json).replace_extension(".png").string() : a.plot;
-    plot::save(update_figure(c, pm, u, f), png, a.force);
+    plot::save(plot::update_figure(c, pm, u, f), png, a.force);
   } else if (!a.plot.empty()) {
-    plot::save(update_figure(c, pm, u, f), a.plot, a.force);
+    plot::save(plot::update_figure(c, pm, u, f), a.plot, a.force);
   }
   return f.converged ? 0 : 1;
 }

@@ -5,19 +5,19 @@
 #include <functional>
 #include <string>
 
+#include "dynid/io/limits.hpp"
+
 namespace dynid::cli {
 
 struct GlobalOptions {
   int threads = 0;
   bool quiet = false;
   bool verbose = false;
+  ReaderLimits limits;  ///< every file the command reads is read within these (dynid's defaults)
   int exit_code = 0;  ///< set by the subcommand that ran
 };
 
 void set_threads(int n);
-/// OpenBLAS's own thread count (CHOLMOD's supernodal factorization); 1 where the threads work on independent
-/// tasks (the starts of a global search), whose solves would otherwise oversubscribe the cores.
-void set_blas_threads(int n);
 
 /// Runs `body`, mapping dynid's exceptions to messages on stderr and exit codes (0, 1, 2, 3).
 int run_guarded(const std::string& command, const std::function<int()>& body);

@@ -1,15 +1,14 @@
 // dynid -- command line. Exit codes: 0 success; 1 numerical failure (solver did not converge, singular
 // matrix); 2 bad input or usage (the message says what and where); 3 internal error (please report).
-#include <CLI/CLI.hpp>
-#include <dlfcn.h>
 #include <fmt/core.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iostream>
 
+#include "blas_kernels.hpp"
 #include "commands.hpp"
 #include "dynid/mesh/error.hpp"
-#include "dynid/solvers/blas.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -26,16 +25,11 @@ void set_threads(int n) {
   set_blas_threads(n);
 }
 
-void set_blas_threads(int n) {
-  using SetThreads = void (*)(int);
-  if (auto f = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) f(n);
-}
-
 }  // namespace dynid::cli
 
 int main(int argc, char** argv) {
   using namespace dynid::cli;
-  dynid::ensure_blas_kernels(argv);
+  ensure_blas_kernels(argv);  // process-level: may re-execute with better OpenBLAS kernels
   CLI::App app{"dynid: finds where a structure differs from its finite-element model, and why, from vibration "
                "measurements.\nExit codes: 0 success, 1 numerical failure, 2 bad input or usage, 3 internal error, 4 a discovery case's expect: not met (discover, run)."};
   app.set_version_flag("--version", std::string("dynid ") + DYNID_VERSION);

@@ -4,5 +4,6 @@
 #include "fuzz_reader.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  return dynid::fuzz::feed(data, size, [](const std::string& b) { dynid::parse_abaqus(b, "fuzz.inp"); });
+  return dynid::fuzz::feed(data, size,
+                           [](const std::string& b) { dynid::parse_abaqus(b, "fuzz.inp", "", dynid::fuzz::limits()); });
 }

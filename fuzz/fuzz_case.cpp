@@ -7,6 +7,7 @@
 #include "fuzz_reader.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  return dynid::fuzz::feed(data, size,
-                           [](const std::string& b) { dynid::parse_case(b, "fuzz.yaml", "/nonexistent/dynid-fuzz"); });
+  return dynid::fuzz::feed(data, size, [](const std::string& b) {
+    dynid::parse_case(b, "fuzz.yaml", "/nonexistent/dynid-fuzz", dynid::fuzz::limits());
+  });
 }

@@ -35,11 +35,11 @@ void each(F f) {  // one malformed variable must not stop the others from being 
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  dynid::reader_limits().max_mat_elements = 1000000;  // 8 MB per variable
   return dynid::fuzz::feed(data, size, [](const std::string& bytes) {
     const std::string path = memory_file(bytes);
     if (path.empty()) return;
-    const dynid::MatFile f(path);
+    const dynid::ReaderLimits limits = dynid::fuzz::limits();
+    const dynid::MatFile f(path, limits);
     const auto vars = f.variables();
     for (const auto& v : vars) {
       each([&] { f.matrix(v.name, "fuzz"); });
@@ -53,13 +53,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       n.K = vars[0].name;
       n.M = vars[1].name;
       n.groups.push_back({"g", vars[0].name, vars[1].name});
-      each([&] { dynid::read_mat_matrix_model(n); });
+      each([&] { dynid::read_mat_matrix_model(n, nullptr, limits); });
     }
-    each([&] { dynid::read_mat_recording(dynid::MatRecordingNames{path}); });
+    each([&] { dynid::read_mat_recording(dynid::MatRecordingNames{path}, limits); });
     each([&] {
       dynid::MatModalNames m;
       m.file = path;
-      dynid::read_mat_modal_data(m);
+      dynid::read_mat_modal_data(m, limits);
     });
   });
 }

@@ -3,5 +3,6 @@
 #include "fuzz_reader.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  return dynid::fuzz::feed(data, size, [](const std::string& b) { dynid::parse_matrix_market(b, "fuzz.mtx"); });
+  return dynid::fuzz::feed(
+      data, size, [](const std::string& b) { dynid::parse_matrix_market(b, "fuzz.mtx", dynid::fuzz::limits()); });
 }

@@ -15,6 +15,7 @@ packages=(
   libplplot-dev plplot-driver-cairo
   chromium  # scripts/check-report.sh: the report checked in a headless browser (ctest report.browser)
   clang libclang-rt-14-dev libomp-dev  # scripts/sanitize.sh, fuzz.sh: clang, libFuzzer, sanitizer run-times, OpenMP
+  clang-format clang-tidy  # scripts/lint.sh (ctest lint.changed): the changed lines formatted and linted
   python3 python3-numpy python3-scipy python3-slepc4py python3-petsc4py
   python3-matplotlib  # bench/discovery: the concealed-physics benchmark's figures
   python3-dev pybind11-dev python3-pytest python3-h5py  # the Python package (python/, docs/python.md) and its tests

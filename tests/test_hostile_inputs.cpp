@@ -78,6 +78,28 @@ TEST(HostileInputs, GeneratorSizeIsCheckedBeforeBuilding) {
   EXPECT_HAS(e, "generate.frame3d: 6.38e+37 elements; at most 1e+07 can be generated");
 }
 
+// Issue 17: the limits are an argument of each reader (the fuzz targets lower them), not a process-wide setting;
+// the default argument gives dynid's limits to every other caller.
+TEST(ReaderLimits, AreAnArgumentNotAProcessSetting) {
+  ReaderLimits low;
+  low.max_matrix_dimension = 2;
+  low.max_generated_elements = 3;
+  low.max_generated_ids = 5;
+  const std::string mtx = "%%MatrixMarket matrix coordinate real general\n3 3 1\n1 1 1\n";
+  EXPECT_HAS(ErrorOf([&] { parse_matrix_market(mtx, "m.mtx", low); }), "(at most 2 rows and columns)");
+  EXPECT_EQ(parse_matrix_market(mtx, "m.mtx").rows(), 3);  // the lowered limits stayed with their call
+  const std::string beam =
+      "model:\n  materials: {steel: {E: 2.1e11, rho: 7850}}\n  sections: {b: {A: 1e-2, I: 1e-4}}\n"
+      "  generate:\n    beam: {elements: 4, material: steel, section: b}\n";
+  EXPECT_HAS(ErrorOf([&] { parse_case(beam, "b.yaml", ".", low); }), "4 elements; at most 3 can be generated");
+  EXPECT_EQ(parse_case(beam, "b.yaml").model.elements().size(), 4u);
+  ReaderLimits enough = low;
+  enough.max_generated_elements = 4;
+  EXPECT_EQ(parse_case(beam, "b.yaml", ".", enough).limits.max_generated_elements, 4);  // kept for its data files
+  const std::string inp = "*NSET, NSET=A, GENERATE\n1, 10, 1\n";
+  EXPECT_HAS(ErrorOf([&] { parse_abaqus(inp, "g.inp", "", low); }), "g.inp:2: *NSET, GENERATE: more than 5 ids");
+}
+
 TEST(HostileInputs, ModalDataNumberTooLargeForADouble) {
   // fuzz_modal_data: nlohmann's out_of_range escaped as a non-InputError exception.
   const std::string e = ErrorOf([] { parse_modal_data_json(Hostile("big-numbers.json"), "big-numbers.json"); });

@@ -32,11 +32,11 @@ std::string MeshData::group_names() const {
   return s.empty() ? "(none)" : s;
 }
 
-MeshData read_mesh_file(const std::string& path) {
+MeshData read_mesh_file(const std::string& path, const ReaderLimits& limits) {
   std::string ext = fs::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
   if (ext == ".msh") return read_gmsh(path);
-  if (ext == ".inp") return read_abaqus(path);
+  if (ext == ".inp") return read_abaqus(path, limits);
   throw InputError(path + ": unknown mesh file type '" + ext + "' (known: .msh Gmsh, .inp Abaqus)");
 }
 
@@ -86,7 +86,7 @@ struct Card {
 
 class AbaqusReader {
  public:
-  explicit AbaqusReader(const std::string& name) {
+  AbaqusReader(const std::string& name, const ReaderLimits& limits) : limits_(limits) {
     out_.file = name;
     out_.names_ignore_case = true;
   }
@@ -247,7 +247,7 @@ class AbaqusReader {
         const int a = integer(f[0], l, "first"), b = integer(f[1], l, "last"), d = f.size() == 3 ? integer(f[2], l, "increment") : 1;
         if (a < 1 || d < 1 || b < a)
           throw InputError(l.where + ": *" + c.name + ", GENERATE: needs 1 <= first <= last and increment >= 1");
-        const long long limit = reader_limits().max_generated_ids;  // dynid/io/limits.hpp
+        const long long limit = limits_.max_generated_ids;
         if ((static_cast<long long>(b) - a) / d >= limit)
           throw InputError(l.where + ": *" + c.name + ", GENERATE: more than " + limit_text(double(limit)) + " ids");
         for (long long k = a; k <= b; k += d) ids.push_back(static_cast<int>(k));
@@ -428,6 +428,7 @@ class AbaqusReader {
   }
 
   MeshData out_;
+  ReaderLimits limits_;
   std::set<int> node_ids_;
   std::unordered_map<int, std::size_t> element_index_;
   std::map<int, int> orientation_nodes_;  // element id -> node id
@@ -437,11 +438,12 @@ class AbaqusReader {
 
 }  // namespace
 
-MeshData parse_abaqus(const std::string& bytes, const std::string& name, const std::string& include_dir) {
-  return AbaqusReader(name).read(bytes, include_dir);
+MeshData parse_abaqus(const std::string& bytes, const std::string& name, const std::string& include_dir,
+                      const ReaderLimits& limits) {
+  return AbaqusReader(name, limits).read(bytes, include_dir);
 }
-MeshData read_abaqus(const std::string& path) {
-  return AbaqusReader(path).read(internal::read_file_bytes(path), folder_of(path));
+MeshData read_abaqus(const std::string& path, const ReaderLimits& limits) {
+  return AbaqusReader(path, limits).read(internal::read_file_bytes(path), folder_of(path));
 }
 
 }  // namespace dynid

@@ -53,7 +53,8 @@ DiscoverSpec::Expect parse_expect(const YAML::Node& n, const YamlCtx& ctx, bool 
 }
 }  // namespace
 
-DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir) {
+DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir,
+                            const ReaderLimits& limits) {
   ctx.require_map(n, "discover");
   ctx.only_keys(n, "discover", {"measured", "geometry", "recordings", "identify", "truth", "modes", "min_mpc", "frequency_noise", "shape_noise",
                                 "kinds", "sensor_nodes", "suspension_nodes", "max_effects", "screen", "seeds", "expect", "units", "gravity"});
@@ -131,7 +132,7 @@ DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model
     YamlCtx tctx = ctx;
     std::string tdir = dir;
     const YAML::Node m = model_node(t, &tctx, &tdir, 0);
-    d.truth = std::make_shared<Model>(parse_model(m, tctx, tdir, nullptr));
+    d.truth = std::make_shared<Model>(parse_model(m, tctx, tdir, nullptr, limits));
     d.truth_test = std::make_shared<TestSpec>(parse_test(t["test"], ctx, *d.truth, dir));
     // The analysis model must know every sensor (the recordings are labelled with the truth's node ids).
     for (const MeasuredDof& s : d.truth_test->options.sensors)
@@ -259,7 +260,7 @@ DiscoveryData discovery_data(const Case& c, int seed_offset) {
   const DiscoverSpec& d = *c.discover;
   DiscoveryData out;
   if (!d.measured_file.empty()) {
-    out.measured = read_measured_modal_data(d.measured_file, d.geometry, c.model, &out.notes, d.measured_mat);
+    out.measured = read_measured_modal_data(d.measured_file, d.geometry, c.model, &out.notes, d.measured_mat, c.limits);
     out.source = d.measured_file;
   } else {
     std::vector<Recording> recs;
@@ -274,11 +275,14 @@ DiscoveryData discovery_data(const Case& c, int seed_offset) {
       // per hit), grouped into tests (io/test_layout.hpp).
       std::vector<std::string> files;
       for (std::size_t k = 0; k < d.recordings.size(); ++k) {
-        if (k < d.recording_mat.size() && !d.recording_mat[k].file.empty()) recs.push_back(read_mat_recording(d.recording_mat[k]));
+        if (k < d.recording_mat.size() && !d.recording_mat[k].file.empty())
+          recs.push_back(read_mat_recording(d.recording_mat[k], c.limits));
         else files.push_back(d.recordings[k]);
       }
       if (!files.empty()) {
-        const TestSet set = read_test_set(files);
+        TestSetOptions read_options;
+        read_options.limits = c.limits;
+        const TestSet set = read_test_set(files, read_options);
         if (set.kind != TestSet::Kind::kRecordings)
           throw InputError(files[0] + (files.size() > 1 ? " ..." : "") + ": discover: recordings: needs time recordings (UFF 58 type 1, text or LabVIEW time tables); these hold " +
                            (set.kind == TestSet::Kind::kFrf ? "FRFs" : "a spectrum"));

@@ -306,11 +306,11 @@ void parse_sections(const YAML::Node& root, const YamlCtx& ctx, Case* c) {
   if (root["detect"]) c->detect = parse_detect(root["detect"], ctx, c->model, c->dir);
   if (root["update"]) c->update = internal::parse_update(root["update"], ctx, c->model, c->dir);
   if (root["test"]) c->test = internal::parse_test(root["test"], ctx, c->model, c->dir);
-  if (root["discover"]) c->discover = internal::parse_discover(root["discover"], ctx, c->model, c->dir);
+  if (root["discover"]) c->discover = internal::parse_discover(root["discover"], ctx, c->model, c->dir, c->limits);
 }
 }  // namespace
 
-Case parse_case(const std::string& text, const std::string& name, const std::string& dir) {
+Case parse_case(const std::string& text, const std::string& name, const std::string& dir, const ReaderLimits& limits) {
   YamlCtx ctx{name};
   YAML::Node root;
   try {
@@ -325,6 +325,7 @@ Case parse_case(const std::string& text, const std::string& name, const std::str
   Case c;
   c.path = name;
   c.dir = dir;
+  c.limits = limits;
   c.name = root["name"] ? ctx.string(root["name"], "name") : fs::path(dir).filename().string();
   if (root["description"]) c.description = ctx.string(root["description"], "description");
   if (!root["model"]) ctx.fail(root, "the case has no model: section");
@@ -332,13 +333,14 @@ Case parse_case(const std::string& text, const std::string& name, const std::str
     YamlCtx mctx = ctx;
     std::string mdir = dir;
     const YAML::Node m = internal::model_node(root, &mctx, &mdir, 0);
-    c.model = internal::parse_model(m, mctx, mdir, &c.notes);
+    c.model = internal::parse_model(m, mctx, mdir, &c.notes, limits);
   }
   parse_sections(root, ctx, &c);
   return c;
 }
 
-Case case_with_model(Model model, const std::string& text, const std::string& name, const std::string& dir) {
+Case case_with_model(Model model, const std::string& text, const std::string& name, const std::string& dir,
+                     const ReaderLimits& limits) {
   if (!model.finalized()) throw InputError(name + ": the model is not finalized (call finalize() first)");
   YamlCtx ctx{name};
   YAML::Node root;
@@ -353,6 +355,7 @@ Case case_with_model(Model model, const std::string& text, const std::string& na
   Case c;
   c.path = name;
   c.dir = dir;
+  c.limits = limits;
   c.name = root["name"] ? ctx.string(root["name"], "name") : name;
   if (root["description"]) c.description = ctx.string(root["description"], "description");
   c.model = std::move(model);
@@ -375,7 +378,8 @@ ModalData simulate(const Model& m, const std::vector<MeasuredDof>& dofs, int cou
 ModalData detect_changed_data(const Case& c, Model* changed) {
   require_section(c, c.detect.has_value(), "detect");
   const DetectSpec& d = *c.detect;
-  if (!d.measured_file.empty()) return read_measured_modal_data(d.measured_file, d.geometry, c.model, nullptr, d.measured_mat);
+  if (!d.measured_file.empty())
+    return read_measured_modal_data(d.measured_file, d.geometry, c.model, nullptr, d.measured_mat, c.limits);
   Model local;
   Model& m = changed ? *changed : local;  // the caller may not want the changed model
   m = changed_model(c.model, d.changes);
@@ -386,7 +390,7 @@ ModalData update_measured_data(const Case& c) {
   require_section(c, c.update.has_value(), "update");
   const UpdateSpec& u = *c.update;
   ModalData m = !u.measured_file.empty()
-                    ? read_measured_modal_data(u.measured_file, u.geometry, c.model, nullptr, u.measured_mat)
+                    ? read_measured_modal_data(u.measured_file, u.geometry, c.model, nullptr, u.measured_mat, c.limits)
                     : simulate(apply_factors(c.model, u.target_changes), u.measured_dofs, u.target_modes,
                                "simulated target of " + c.name);
   return first_modes(std::move(m), u.modes);
@@ -403,9 +407,9 @@ ModalData first_modes(ModalData m, int count) {
   return m;
 }
 
-Case load_case(const std::string& path) {
+Case load_case(const std::string& path, const ReaderLimits& limits) {
   const std::string file = resolve_case_path(path);
-  return parse_case(internal::read_file_bytes(file), file, fs::path(file).parent_path().string());
+  return parse_case(internal::read_file_bytes(file), file, fs::path(file).parent_path().string(), limits);
 }
 
 }  // namespace dynid

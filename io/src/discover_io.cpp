@@ -4,6 +4,7 @@
 #include <cmath>
 #include <set>
 
+#include "dynid/io/figures.hpp"
 #include "dynid/io/modal_data_io.hpp"
 #include "internal/text_util.hpp"
 
@@ -491,53 +492,21 @@ plot::Figure discovery_figure(const Case& c, const DiscoverySummary& s) {
   rank.ymin = std::min(lo, 0.0);
 
   // (3) frequency errors and (4) MAC, before and after.
-  plot::Panel fe, mac;
+  const std::string after = s.findings.empty() ? "model as given" : "with the findings";
+  plot::ModeComparisonPanels fm = plot::mode_comparison_panels(
+      {{"model as given", 0, s.before.model_hz, s.before.measured_hz, s.before.mac, s.before.paired},
+       {after, 3, s.after.model_hz, s.after.measured_hz, s.after.mac, {}}},
+      0.38);
+  plot::Panel& fe = fm.frequency;
+  plot::Panel& mac = fm.mac;
   fe.title = "Fit: frequency error per mode";
   fe.ylabel = "model - measured [%]";
   fe.xlabel = "measured mode";
   mac.title = "Fit: MAC per mode";
-  mac.ylabel = "MAC";
   mac.xlabel = "measured mode";
-  plot::Series fb, fa, mb, ma;
-  fb.kind = fa.kind = plot::Kind::kBars;
-  fb.bar_width = fa.bar_width = 0.38;
-  fb.dx = -0.2;
-  fa.dx = 0.2;
-  fb.label = mb.label = "model as given";
-  fa.label = ma.label = s.findings.empty() ? "model as given" : "with the findings";
-  fb.color = mb.color = 0;
-  fa.color = ma.color = 3;
-  mb.kind = ma.kind = plot::Kind::kLineMarkers;
-  plot::Series lost;
-  lost.label = "x  no plausible model partner";
-  lost.kind = plot::Kind::kMarkers;
-  lost.symbol = 5;
-  lost.symbol_scale = 2.0;
-  lost.color = 0;
-  for (Eigen::Index k = 0; k < s.before.measured_hz.size(); ++k) {
-    const double x = static_cast<double>(k + 1);
-    if (s.before.paired.empty() || s.before.paired[static_cast<std::size_t>(k)]) {
-      fb.x.push_back(x);
-      fb.y.push_back(100 * (s.before.model_hz[k] - s.before.measured_hz[k]) / s.before.measured_hz[k]);
-    } else {
-      lost.x.push_back(x - 0.2);
-      lost.y.push_back(0.0);
-    }
-    mb.x.push_back(x);
-    mb.y.push_back(s.before.mac[k]);
-    if (k < s.after.model_hz.size()) {
-      fa.x.push_back(x);
-      fa.y.push_back(100 * (s.after.model_hz[k] - s.after.measured_hz[k]) / s.after.measured_hz[k]);
-      ma.x.push_back(x);
-      ma.y.push_back(s.after.mac[k]);
-    }
-  }
-  fe.series = {fb, fa};
-  if (!lost.x.empty()) fe.series.push_back(lost);
   fe.hlines = {{0.0, ""}};
-  mac.series = {mb, ma};
   double mmin = 1;
-  for (double v : mb.y) mmin = std::min(mmin, v);
+  for (double v : mac.series[0].y) mmin = std::min(mmin, v);
   mac.ymin = std::max(0.0, std::min(0.9, mmin - 0.02));
   mac.ymax = 1.005;
   f.panels = {map, rank, fe, mac};

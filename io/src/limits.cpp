@@ -1,21 +1,15 @@
 #include "dynid/io/limits.hpp"
 
 #include <cmath>
-#include <cstdio>
+
+#include "internal/text_util.hpp"
 
 namespace dynid {
-
-ReaderLimits& reader_limits() {
-  static ReaderLimits limits;
-  return limits;
-}
 
 std::string limit_text(double value) {
   const double e = std::log10(value);
   if (value >= 1000 && std::abs(e - std::round(e)) < 1e-12) return "10^" + std::to_string(std::lround(e));
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.15g", value);
-  return buf;
+  return internal::format_number(value, 15);
 }
 
 }  // namespace dynid

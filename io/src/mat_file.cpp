@@ -9,12 +9,13 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
-#include <new>
 #include <mutex>
+#include <new>
 
 #include "dynid/io/limits.hpp"
 #include "dynid/io/modal_data_io.hpp"
 #include "dynid/mesh/error.hpp"
+#include "internal/text_util.hpp"
 
 namespace dynid {
 
@@ -71,12 +72,12 @@ std::string dims_text(const matvar_t* v) {
   return s.empty() ? "0 x 0" : s;
 }
 
-// Number of elements, or -1 when the product overflows or exceeds the reader limit.
-long long numel(const matvar_t* v) {
+// Number of elements, or -1 when the product overflows or exceeds `max` (ReaderLimits::max_mat_elements).
+long long numel(const matvar_t* v, long long max) {
   if (v->rank < 0 || (v->rank > 0 && !v->dims)) return -1;
   long double n = 1;
   for (int k = 0; k < v->rank; ++k) n *= static_cast<long double>(v->dims[k]);
-  if (n > static_cast<long double>(reader_limits().max_mat_elements)) return -1;
+  if (n > static_cast<long double>(max)) return -1;
   return static_cast<long long>(n);
 }
 
@@ -107,11 +108,7 @@ double element(const void* p, matio_types t, std::size_t k) {
   }
 }
 
-std::string int_text(double v) {
-  char b[64];
-  std::snprintf(b, sizeof b, "%.17g", v);
-  return b;
-}
+std::string int_text(double v) { return internal::format_number(v, 17); }
 
 }  // namespace
 
@@ -131,16 +128,19 @@ struct MatFile::Handle {
       g_last_message.clear();
       throw InputError(path + ": no variable '" + name + "' (" + what + "); the file holds: " + file.listing());
     }
-    if (numel(info.get()) < 0)
-      fail(path, name, "a " + dims_text(info.get()) + " array is larger than dynid reads (" +
-                           limit_text(static_cast<double>(reader_limits().max_mat_elements)) + " elements)");
+    const long long max = file.limits().max_mat_elements;
+    if (numel(info.get(), max) < 0)
+      fail(path, name,
+           "a " + dims_text(info.get()) + " array is larger than dynid reads (" + limit_text(static_cast<double>(max)) +
+               " elements)");
     // A damaged header can declare far more data than the file holds, and libmatio allocates what it declares
     // before reading (fuzz_mat found a 4 GB request from a 1 kB file). Data never exceeds the file by more than
     // zlib's largest ratio (about 1032:1); sparse arrays hold fewer values than their dimensions.
     if (info->class_type != MAT_C_SPARSE) {
       std::error_code ec;
       const double file_bytes = static_cast<double>(std::filesystem::file_size(path, ec));
-      const double bytes = static_cast<double>(numel(info.get())) * static_cast<double>(Mat_SizeOfClass(info->class_type));
+      const double bytes =
+          static_cast<double>(numel(info.get(), max)) * static_cast<double>(Mat_SizeOfClass(info->class_type));
       if (!ec && bytes > 1100.0 * file_bytes + 1e6)
         fail(path, name, "declares a " + dims_text(info.get()) + " array (" + limit_text(bytes) + " bytes) in a file of " +
                              limit_text(file_bytes) + " bytes: the file is damaged; save it again from MATLAB or SciPy");
@@ -149,12 +149,13 @@ struct MatFile::Handle {
     Mat_Rewind(mat);
     Var v(Mat_VarRead(mat, name.c_str()));
     if (!v) fail(path, name, "cannot be read; the file is damaged or uses a feature dynid does not read" + matio_says());
-    if (numel(v.get()) < 0) fail(path, name, "a " + dims_text(v.get()) + " array is larger than dynid reads");
+    if (numel(v.get(), max) < 0) fail(path, name, "a " + dims_text(v.get()) + " array is larger than dynid reads");
     return v;
   }
 };
 
-MatFile::MatFile(const std::string& path) : path_(path), h_(std::make_unique<Handle>()) {
+MatFile::MatFile(const std::string& path, const ReaderLimits& limits)
+    : path_(path), limits_(limits), h_(std::make_unique<Handle>()) {
   quiet_matio();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": cannot open the file (no such file)");
@@ -212,8 +213,8 @@ std::string MatFile::listing() const {
 
 namespace {
 
-// A matvar's real numeric content as a dense matrix (rows x cols), checked; `who` names it.
-Eigen::MatrixXd dense_of(const matvar_t* v, const std::string& who) {
+// A matvar's real numeric content as a dense matrix (rows x cols), checked; `who` names it; `max`: numel's.
+Eigen::MatrixXd dense_of(const matvar_t* v, const std::string& who, long long max) {
   if (v->isComplex) throw InputError(who + " is complex; real values are needed");
   if (v->rank > 2) throw InputError(who + " is a " + dims_text(v) + " array; a matrix (2-D) is needed");
   const auto rows = static_cast<Eigen::Index>(v->rank >= 1 ? v->dims[0] : 0);
@@ -247,7 +248,7 @@ Eigen::MatrixXd dense_of(const matvar_t* v, const std::string& who) {
   }
   if (!numeric_class(v->class_type))
     throw InputError(who + " is a " + std::string(class_name(v)) + " (" + dims_text(v) + "); a numeric matrix is needed");
-  const long long n = numel(v);
+  const long long n = numel(v, max);
   const int ts = type_size(v->data_type);
   if (n > 0 && (!v->data || ts == 0 || v->nbytes < static_cast<std::size_t>(n) * static_cast<std::size_t>(ts)))
     throw InputError(who + ": its data is incomplete (" + std::to_string(v->nbytes) + " bytes for " + std::to_string(n) + " values)");
@@ -267,7 +268,7 @@ std::string who(const std::string& path, const std::string& name, const std::str
   return path + ": variable '" + name + "' (" + what + ")";
 }
 
-std::vector<std::string> strings_of(const matvar_t* v, const std::string& w) {
+std::vector<std::string> strings_of(const matvar_t* v, const std::string& w, long long max) {
   std::vector<std::string> out;
   if (v->class_type == MAT_C_CHAR) {
     if (v->rank != 2) throw InputError(w + " is a " + dims_text(v) + " char array; one string per row is needed");
@@ -290,11 +291,11 @@ std::vector<std::string> strings_of(const matvar_t* v, const std::string& w) {
     return out;
   }
   if (v->class_type == MAT_C_CELL) {
-    const long long n = numel(v);
+    const long long n = numel(v, max);
     for (long long k = 0; k < n; ++k) {
       matvar_t* c = Mat_VarGetCell(const_cast<matvar_t*>(v), static_cast<int>(k));
       if (!c) throw InputError(w + ": cell " + std::to_string(k + 1) + " is missing");
-      const std::vector<std::string> s = strings_of(c, w + " cell " + std::to_string(k + 1));
+      const std::vector<std::string> s = strings_of(c, w + " cell " + std::to_string(k + 1), max);
       out.push_back(s.empty() ? std::string() : s[0]);
     }
     return out;
@@ -306,7 +307,7 @@ std::vector<std::string> strings_of(const matvar_t* v, const std::string& w) {
 
 Eigen::MatrixXd MatFile::matrix(const std::string& name, const std::string& what) const {
   Var v = h_->read(path_, name, what, *this);
-  Eigen::MatrixXd A = dense_of(v.get(), who(path_, name, what));
+  Eigen::MatrixXd A = dense_of(v.get(), who(path_, name, what), limits_.max_mat_elements);
   require_finite(A, who(path_, name, what));
   return A;
 }
@@ -326,7 +327,7 @@ SparseMatrix MatFile::sparse(const std::string& name, const std::string& what) c
   if (x->rank != 2 || x->dims[0] != x->dims[1])
     throw InputError(w + " is " + dims_text(x) + "; a square matrix is needed");
   if (x->class_type != MAT_C_SPARSE) {
-    const Eigen::MatrixXd D = dense_of(x, w);
+    const Eigen::MatrixXd D = dense_of(x, w, limits_.max_mat_elements);
     require_finite(D, w);
     SparseMatrix A = D.sparseView();
     A.makeCompressed();
@@ -367,7 +368,7 @@ double MatFile::scalar(const std::string& name, const std::string& what) const {
 
 std::vector<std::string> MatFile::strings(const std::string& name, const std::string& what) const {
   Var v = h_->read(path_, name, what, *this);
-  return strings_of(v.get(), who(path_, name, what));
+  return strings_of(v.get(), who(path_, name, what), limits_.max_mat_elements);
 }
 
 std::vector<Eigen::MatrixXd> MatFile::matrices(const std::string& name, const std::string& what) const {
@@ -376,12 +377,12 @@ std::vector<Eigen::MatrixXd> MatFile::matrices(const std::string& name, const st
   if (v->class_type != MAT_C_CELL)
     throw InputError(w + " is a " + std::string(class_name(v.get())) + "; a cell array of matrices is needed");
   std::vector<Eigen::MatrixXd> out;
-  const long long n = numel(v.get());
+  const long long n = numel(v.get(), limits_.max_mat_elements);
   for (long long k = 0; k < n; ++k) {
     matvar_t* c = Mat_VarGetCell(v.get(), static_cast<int>(k));
     const std::string wc = w + " cell " + std::to_string(k + 1);
     if (!c) throw InputError(wc + " is missing");
-    out.push_back(dense_of(c, wc));
+    out.push_back(dense_of(c, wc, limits_.max_mat_elements));
     require_finite(out.back(), wc);
   }
   return out;
@@ -410,8 +411,9 @@ std::vector<DofRow> dof_rows(const MatFile& f, const std::string& var, const std
 
 }  // namespace
 
-MatrixModelData read_mat_matrix_model(const MatModelNames& n, std::vector<std::string>* notes) {
-  const MatFile f(n.file);
+MatrixModelData read_mat_matrix_model(const MatModelNames& n, std::vector<std::string>* notes,
+                                      const ReaderLimits& limits) {
+  const MatFile f(n.file, limits);
   MatrixModelData d;
   if (n.K.empty() != n.M.empty())
     throw InputError(n.file + ": give both K and M (the assembled matrices), or neither");
@@ -500,8 +502,9 @@ MatrixModelData read_mat_matrix_model(const MatModelNames& n, std::vector<std::s
       const auto m = static_cast<Eigen::Index>(em.equations.size());
       if (Ke[e].rows() != m || Ke[e].cols() != m || (!Me.empty() && (Me[e].rows() != m || Me[e].cols() != m)))
         throw InputError(w + ": K and M must be " + std::to_string(m) + " x " + std::to_string(m) + " for its " + std::to_string(m) + " equations");
-      if (m > reader_limits().max_element_dofs)
-        throw InputError(w + ": " + std::to_string(m) + " DOFs; an element has at most " + limit_text(reader_limits().max_element_dofs));
+      if (m > limits.max_element_dofs)
+        throw InputError(w + ": " + std::to_string(m) + " DOFs; an element has at most " +
+                         limit_text(limits.max_element_dofs));
       em.K = Ke[e];
       em.M = Me.empty() ? Eigen::MatrixXd::Zero(m, m) : Me[e];
       if (!groups.empty()) em.group = groups[e];
@@ -511,8 +514,8 @@ MatrixModelData read_mat_matrix_model(const MatModelNames& n, std::vector<std::s
   return d;
 }
 
-Recording read_mat_recording(const MatRecordingNames& n) {
-  const MatFile f(n.file);
+Recording read_mat_recording(const MatRecordingNames& n, const ReaderLimits& limits) {
+  const MatFile f(n.file, limits);
   Recording r;
   r.source = n.file;
   r.sample_rate_hz = n.sample_rate_hz > 0 ? n.sample_rate_hz : f.scalar(n.sample_rate, "the sampling rate in Hz");
@@ -563,8 +566,8 @@ Recording read_mat_recording(const MatRecordingNames& n) {
   return r;
 }
 
-ModalData read_mat_modal_data(const MatModalNames& n) {
-  const MatFile f(n.file);
+ModalData read_mat_modal_data(const MatModalNames& n, const ReaderLimits& limits) {
+  const MatFile f(n.file, limits);
   ModalData m;
   m.source = n.file;
   if (!n.eigenvalues.empty()) {
@@ -584,7 +587,7 @@ ModalData read_mat_modal_data(const MatModalNames& n) {
                      " for " + std::to_string(m.frequencies_hz.size()) + " modes; DOFs x modes is needed" +
                      (transposed ? " (it looks transposed)" : ""));
   }
-  const std::unique_ptr<MatFile> other = n.dofs_file.empty() ? nullptr : std::make_unique<MatFile>(n.dofs_file);
+  const std::unique_ptr<MatFile> other = n.dofs_file.empty() ? nullptr : std::make_unique<MatFile>(n.dofs_file, limits);
   const MatFile& fd = other ? *other : f;
   bool text = false, vector = false;
   for (const MatFile::Info& i : fd.variables())

@@ -34,11 +34,11 @@ void write_matrix_market(const std::string& path, const SparseMatrix& A, bool sy
   write_file_atomic(path, out, overwrite);
 }
 
-SparseMatrix read_matrix_market(const std::string& path) {
-  return parse_matrix_market(internal::read_file_bytes(path), path);
+SparseMatrix read_matrix_market(const std::string& path, const ReaderLimits& limits) {
+  return parse_matrix_market(internal::read_file_bytes(path), path, limits);
 }
 
-SparseMatrix parse_matrix_market(const std::string& text, const std::string& path) {
+SparseMatrix parse_matrix_market(const std::string& text, const std::string& path, const ReaderLimits& limits) {
   std::istringstream in(text);
   std::string line;
   long long lineno = 0;
@@ -71,7 +71,7 @@ SparseMatrix parse_matrix_market(const std::string& text, const std::string& pat
   }
   if (rows < 0) fail("missing size line 'rows cols entries'");
   // The sparse matrix allocates per column whatever the entries, so the declared size must be bounded.
-  const long long max_dimension = reader_limits().max_matrix_dimension;  // dynid/io/limits.hpp
+  const long long max_dimension = limits.max_matrix_dimension;
   if (rows <= 0 || cols <= 0 || nnz < 0 || rows > max_dimension || cols > max_dimension)
     fail("invalid sizes " + std::to_string(rows) + " x " + std::to_string(cols) + ", " + std::to_string(nnz) +
          " entries (at most " + std::to_string(max_dimension) + " rows and columns)");

@@ -140,13 +140,14 @@ Eigen::MatrixXd read_block(LineReader& r, const std::string& name, const std::st
 
 }  // namespace
 
-std::vector<ElementMatrices> parse_element_matrices(const std::string& text, const std::string& name, int num_equations) {
+std::vector<ElementMatrices> parse_element_matrices(const std::string& text, const std::string& name, int num_equations,
+                                                    const ReaderLimits& limits) {
   LineReader r(text);
   std::string_view line;
   if (!r.next(&line) || trim(line) != "%%dynid element-matrices 1")
     fail_at(name, 1, "not an element-matrices file: the first line must be '%%dynid element-matrices 1' "
                      "(docs/matrix-input.md)");
-  const int max_dofs = reader_limits().max_element_dofs;
+  const int max_dofs = limits.max_element_dofs;
   std::vector<ElementMatrices> out;
   std::set<int> ids;
   while (r.next(&line)) {
@@ -213,7 +214,8 @@ std::vector<ElementMatrices> parse_element_matrices(const std::string& text, con
   return out;
 }
 
-void add_matrix_model(const MatrixModelFiles& files, Model* model, std::vector<std::string>* notes) {
+void add_matrix_model(const MatrixModelFiles& files, Model* model, std::vector<std::string>* notes,
+                      const ReaderLimits& limits) {
   if (files.dofs.empty()) throw InputError("matrix model: the DOF table (dofs:) is required");
   if (files.elements.empty() && files.groups.empty())
     throw InputError("matrix model: give element matrices (elements:) or group matrices (groups:)");
@@ -226,23 +228,25 @@ void add_matrix_model(const MatrixModelFiles& files, Model* model, std::vector<s
     d.nodes_name = files.nodes;
   }
   const int n = static_cast<int>(d.dofs.size());
-  if (!files.elements.empty()) d.elements = parse_element_matrices(internal::read_file_bytes(files.elements), files.elements, n);
+  if (!files.elements.empty())
+    d.elements = parse_element_matrices(internal::read_file_bytes(files.elements), files.elements, n, limits);
   for (const MatrixModelFiles::Group& g : files.groups) {
     if (g.K.empty() && g.M.empty()) throw InputError("matrix model: group '" + g.name + "' names neither a K nor an M file");
-    d.groups.push_back({g.name, g.K, g.M, g.K.empty() ? SparseMatrix() : read_matrix_market(g.K),
-                        g.M.empty() ? SparseMatrix() : read_matrix_market(g.M)});
+    d.groups.push_back({g.name, g.K, g.M, g.K.empty() ? SparseMatrix() : read_matrix_market(g.K, limits),
+                        g.M.empty() ? SparseMatrix() : read_matrix_market(g.M, limits)});
   }
   if (!files.K.empty()) {
     d.has_assembled = true;
-    d.K = read_matrix_market(files.K);
+    d.K = read_matrix_market(files.K, limits);
     d.K_name = files.K;
-    d.M = read_matrix_market(files.M);
+    d.M = read_matrix_market(files.M, limits);
     d.M_name = files.M;
   }
-  add_matrix_model(d, model, notes);
+  add_matrix_model(d, model, notes, limits);
 }
 
-void add_matrix_model(const MatrixModelData& data, Model* model, std::vector<std::string>* notes) {
+void add_matrix_model(const MatrixModelData& data, Model* model, std::vector<std::string>* notes,
+                      const ReaderLimits& limits) {
   const std::vector<DofRow>& dofs = data.dofs;
   const int n = static_cast<int>(dofs.size());
   if (n == 0) throw InputError("matrix model: " + data.dofs_name + " lists no DOFs");
@@ -296,9 +300,10 @@ void add_matrix_model(const MatrixModelData& data, Model* model, std::vector<std
     for (int i = 0; i < n; ++i)
       if (used[i]) e.equations.push_back(i);
     const int m = static_cast<int>(e.equations.size());
-    if (m > reader_limits().max_element_dofs)
-      throw InputError(what + " acts on " + std::to_string(m) + " DOFs; a group or remainder is one dense element of at most " +
-                       limit_text(reader_limits().max_element_dofs) + " DOFs: export element matrices instead");
+    if (m > limits.max_element_dofs)
+      throw InputError(what + " acts on " + std::to_string(m) +
+                       " DOFs; a group or remainder is one dense element of at most " +
+                       limit_text(limits.max_element_dofs) + " DOFs: export element matrices instead");
     std::vector<int> local(n, -1);
     for (int k = 0; k < m; ++k) local[e.equations[k]] = k;
     e.K = Eigen::MatrixXd::Zero(m, m);

@@ -5,14 +5,14 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "internal/text_util.hpp"
+
 namespace dynid {
 
 namespace {
 double round6(double v) {
   if (!std::isfinite(v) || v == 0) return 0.0;
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return std::strtod(b, nullptr);
+  return std::strtod(internal::format_number(v, 6).c_str(), nullptr);
 }
 }  // namespace
 

@@ -33,6 +33,7 @@ struct Parser {
   std::map<int, std::string> element_where;   // element id -> "file:line" in a mesh file
   MeshData mesh;                              // model.file, if given
   std::vector<int> file_material, file_section;  // mesh material/section index -> model index
+  ReaderLimits limits;                           // of the files read and of generate:
 
   [[noreturn]] void fail(const YAML::Node& n, const std::string& m) const { ctx.fail(n, m); }
 
@@ -382,7 +383,7 @@ struct Parser {
       if (e["groups"]) n.element_groups = var(e["groups"], "elements groups");
     }
     if (n.groups.empty() && n.element_K.empty()) fail(m, "model matrices: name groups (group stiffness variables) or elements (cell arrays)");
-    add_matrix_model(read_mat_matrix_model(n, notes), &model, notes);
+    add_matrix_model(read_mat_matrix_model(n, notes, limits), &model, notes, limits);
   }
 
   void read_matrices(const YAML::Node& m) {
@@ -417,7 +418,7 @@ struct Parser {
                             kv.second["M"] ? file(kv.second["M"], w + " M") : ""});
       }
     }
-    add_matrix_model(f, &model, notes);
+    add_matrix_model(f, &model, notes, limits);
   }
 
   /// model: {file: frame.msh | frame.inp}: reads the mesh file and adds its materials and sections (Abaqus),
@@ -426,7 +427,7 @@ struct Parser {
     const std::string path = resolve(dir, ctx.string(f, "model file"));
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec)) fail(f, "model file: cannot open '" + path + "'");
-    mesh = read_mesh_file(path);
+    mesh = read_mesh_file(path, limits);
     if (notes)
       for (const std::string& s : mesh.skipped) notes->push_back(mesh.file + ": skipped " + s);
     for (const Material& m : mesh.materials) {
@@ -526,8 +527,8 @@ struct Parser {
     // The size a generator is asked for is checked before anything is allocated (in doubles: no overflow).
     auto check_size = [&](double elements) {
       // The largest model `generate:` builds, so that a case file cannot ask for more memory than a machine has
-      // (bench/ goes to 10^6 DOFs, about 3 x 10^5 elements): dynid/io/limits.hpp.
-      const double max_elements = reader_limits().max_generated_elements;
+      // (bench/ goes to 10^6 DOFs, about 3 x 10^5 elements): ReaderLimits::max_generated_elements.
+      const double max_elements = limits.max_generated_elements;
       if (elements <= max_elements) return;
       char buf[96];
       std::snprintf(buf, sizeof buf, "%.4g elements; at most %.4g can be generated", elements, max_elements);
@@ -579,12 +580,13 @@ struct Parser {
 
 }  // namespace
 
-Model parse_model(const YAML::Node& node, const YamlCtx& ctx, const std::string& dir, std::vector<std::string>* notes) {
+Model parse_model(const YAML::Node& node, const YamlCtx& ctx, const std::string& dir, std::vector<std::string>* notes,
+                  const ReaderLimits& limits) {
   ctx.require_map(node, "model");
   ctx.only_keys(node, "model", {"element", "mass", "rotary_inertia", "materials", "sections", "defaults", "nodes",
                                 "elements", "point_masses", "springs", "supports", "generate", "units", "file",
                                 "groups", "matrices"});
-  Parser p{ctx, {}, {}, {}, {}, {}, {}, {}, ElementType::Frame2D, false, dir, notes, {}, {}, {}, {}};
+  Parser p{ctx, {}, {}, {}, {}, {}, {}, {}, ElementType::Frame2D, false, dir, notes, {}, {}, {}, {}, limits};
   if (node["element"]) {
     p.default_type = p.member_type(node["element"], "model");
     p.have_default_type = true;

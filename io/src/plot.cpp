@@ -26,9 +26,9 @@ int on_plplot_exit(const char* msg) {  // PLplot must not exit() the program
 
 // White background, black axes, then a ten-colour palette (matplotlib's tab10).
 void palette() {
-  static PLINT r[] = {255, 0, 31, 255, 44, 214, 148, 140, 227, 127, 188, 23, 200};
-  static PLINT g[] = {255, 0, 119, 127, 160, 39, 103, 86, 119, 127, 189, 190, 200};
-  static PLINT b[] = {255, 0, 180, 14, 44, 40, 189, 75, 194, 127, 34, 207, 200};
+  static const PLINT r[] = {255, 0, 31, 255, 44, 214, 148, 140, 227, 127, 188, 23, 200};
+  static const PLINT g[] = {255, 0, 119, 127, 160, 39, 103, 86, 119, 127, 189, 190, 200};
+  static const PLINT b[] = {255, 0, 180, 14, 44, 40, 189, 75, 194, 127, 34, 207, 200};
   plscmap0(r, g, b, 13);
 }
 constexpr int kAxis = 1, kGrid = 12, kFirst = 2;

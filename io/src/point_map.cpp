@@ -92,12 +92,13 @@ void relabel_points(const std::map<int, int>& map, const std::string& source, Mo
 }
 
 ModalData read_measured_modal_data(const std::string& file, const GeometrySpec& geometry, const Model& model,
-                                   std::vector<std::string>* notes, const MatModalNames& mat) {
+                                   std::vector<std::string>* notes, const MatModalNames& mat,
+                                   const ReaderLimits& limits) {
   const std::string ext = std::filesystem::path(file).extension().string();
   if (ext == ".mat") {
     MatModalNames names = mat;
     names.file = file;
-    ModalData d = read_mat_modal_data(names);
+    ModalData d = read_mat_modal_data(names, limits);
     if (!geometry.file.empty()) relabel_points(map_test_points(model, read_uff(geometry.file), geometry, notes), file, &d);
     return d;
   }

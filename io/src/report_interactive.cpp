@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <mutex>
 
 #include "internal/text_util.hpp"
 
@@ -125,15 +124,15 @@ bool interactive_available(std::string* why) {
 }
 
 const std::string& interactive_assets() {
-  static std::once_flag once;
-  static std::string assets;
-  std::call_once(once, [] {
-    if (!interactive_available(nullptr)) return;
+  // Built once (thread-safe initialization of a function-local constant), then only read.
+  static const std::string assets = []() -> std::string {
+    if (!interactive_available(nullptr)) return "";
     const std::string plotly = gzip(read_file_bytes(DYNID_PLOTLY_JS));
-    if (plotly.empty()) return;
-    assets = "<script>" + inline_js(DYNID_THREE_JS) + "\n</script>\n<script>" + inline_js(DYNID_ORBIT_JS) + "\n</script>\n" +
-             "<script id=\"plotly-gz\" type=\"application/octet-stream\">" + base64(plotly) + "</script>\n";
-  });
+    if (plotly.empty()) return "";
+    return "<script>" + inline_js(DYNID_THREE_JS) + "\n</script>\n<script>" + inline_js(DYNID_ORBIT_JS) +
+           "\n</script>\n" + "<script id=\"plotly-gz\" type=\"application/octet-stream\">" + base64(plotly) +
+           "</script>\n";
+  }();
   return assets;
 }
 

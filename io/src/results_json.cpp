@@ -21,7 +21,8 @@ DetectSummary detect_case(const Case& c) {
   const ModalData changed = detect_changed_data(c, &changed_m);
   if (!d.changes.empty()) opt.simulated_changed = &changed_m;
   ModalData refmeas;
-  if (!d.reference_measured_file.empty()) refmeas = read_measured_modal_data(d.reference_measured_file, d.geometry, c.model);
+  if (!d.reference_measured_file.empty())
+    refmeas = read_measured_modal_data(d.reference_measured_file, d.geometry, c.model, nullptr, {}, c.limits);
   return detect(c.model, changed, opt, d.reference_measured_file.empty() ? nullptr : &refmeas);
 }
 

@@ -476,7 +476,7 @@ LvmFile parse_lvm(const std::string& bytes, const std::string& path) {
   return out;
 }
 
-TestData read_test_data(const std::string& path, double sample_rate_hz, TableKind kind) {
+TestData read_test_data(const std::string& path, double sample_rate_hz, TableKind kind, const ReaderLimits& limits) {
   std::string ext = lower(std::filesystem::path(path).extension().string());
   if (ext == ".mat") {  // a MATLAB recording: data (channels x samples), fs, channels (dynid/io/mat_file.hpp)
     MatRecordingNames names;
@@ -484,7 +484,7 @@ TestData read_test_data(const std::string& path, double sample_rate_hz, TableKin
     names.sample_rate_hz = sample_rate_hz;
     TestData d;
     d.kind = TestData::Kind::kTimeHistory;
-    d.recording = read_mat_recording(names);
+    d.recording = read_mat_recording(names, limits);
     return d;
   }
   if (ext != ".uff" && ext != ".unv" && ext != ".lvm" && ext != ".txt" && ext != ".csv" && ext != ".dat" && ext != ".tsv") {

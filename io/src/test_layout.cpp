@@ -9,16 +9,13 @@
 
 #include "dynid/io/modal_data_io.hpp"
 #include "dynid/mesh/error.hpp"
+#include "internal/text_util.hpp"
 
 namespace dynid {
 
 namespace {
 
-std::string fmt_num(double v) {
-  char b[64];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
+std::string fmt_num(double v) { return internal::format_number(v, 6); }
 
 // One channel's samples of one record, and where they came from.
 struct Piece {
@@ -402,7 +399,7 @@ TestSet assemble_test_set(const std::vector<TestData>& files, const std::vector<
 
 TestSet read_test_set(const std::vector<std::string>& paths, const TestSetOptions& o) {
   std::vector<TestData> files;
-  for (const std::string& p : paths) files.push_back(read_test_data(p, o.sample_rate_hz, o.kind));
+  for (const std::string& p : paths) files.push_back(read_test_data(p, o.sample_rate_hz, o.kind, o.limits));
   return assemble_test_set(files, paths, o);
 }
 

@@ -552,8 +552,7 @@ ElementParts Model::element_parts(int e) const {
 
 Eigen::MatrixXd Model::unit_geometric_stiffness(int e) const {
   require_finalized("unit_geometric_stiffness");
-  const ElementType t = elements_[e].type;
-  if (t == ElementType::PointMass || t == ElementType::Spring || t == ElementType::Matrix)
+  if (!is_member(elements_[e].type))
     throw InputError("element " + std::to_string(elements_[e].id) + ": only beams and frames have a geometric stiffness");
   internal::MemberLocal loc;
   Eigen::MatrixXd T;
@@ -565,7 +564,7 @@ Eigen::MatrixXd Model::unit_geometric_stiffness(int e) const {
 Eigen::MatrixXd Model::member_point_interpolation(int e, double xi, Eigen::MatrixXd* dN) const {
   require_finalized("member_point_interpolation");
   const ElementType t = elements_[e].type;
-  if (t != ElementType::Beam2D && t != ElementType::Frame2D && t != ElementType::Frame3D)
+  if (!is_member(t))
     throw InputError("element " + std::to_string(elements_[e].id) + ": only beams and frames have a member axis");
   internal::MemberLocal loc;
   Eigen::MatrixXd T;  // local DOFs from the element's global DOFs

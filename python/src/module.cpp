@@ -3,7 +3,6 @@
 
 #include "bindings.hpp"
 #include "dynid/mesh/error.hpp"
-#include "dynid/solvers/blas.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>

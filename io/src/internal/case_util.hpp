@@ -36,7 +36,8 @@ UpdateSpec parse_update(const YAML::Node& n, const YamlCtx& ctx, const Model& mo
 /// The `test:` section (io/src/case_test.cpp).
 TestSpec parse_test(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir);
 /// The `discover:` section (io/src/case_discover.cpp).
-DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir);
+DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir,
+                            const ReaderLimits& limits);
 /// The model section of `root` (root["model"]), following model: {include: FILE}; ctx->file and *dir follow it.
 YAML::Node model_node(const YAML::Node& root, YamlCtx* ctx, std::string* dir, int depth);
 

@@ -2,9 +2,9 @@
 // The format is documented in docs/case-file.md; every error names the file, line and column.
 #pragma once
 
+#include <cstdint>
 #include <limits>
 #include <memory>
-#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,12 +12,13 @@
 #include "dynid/engine/detect.hpp"
 #include "dynid/engine/discovery.hpp"
 #include "dynid/engine/identify.hpp"
-#include "dynid/engine/virtual_test.hpp"
 #include "dynid/engine/model_fit.hpp"
 #include "dynid/engine/multistart.hpp"
+#include "dynid/engine/parametric.hpp"
+#include "dynid/engine/virtual_test.hpp"
+#include "dynid/io/limits.hpp"
 #include "dynid/io/mat_file.hpp"
 #include "dynid/io/point_map.hpp"
-#include "dynid/engine/parametric.hpp"
 #include "dynid/mesh/model.hpp"
 #include "dynid/solvers/eigen.hpp"
 
@@ -117,20 +118,23 @@ struct Case {
   std::optional<UpdateSpec> update;
   std::optional<TestSpec> test;
   std::optional<DiscoverSpec> discover;
+  ReaderLimits limits;  ///< what its files were (and the data files it names are) read within
 };
 
 /// Loads a case from a case file, or from a folder holding case.yaml / case.yml / case.json.
-/// Throws InputError("<file>:<line>:<col>: <what is wrong>; <what to do>").
-Case load_case(const std::string& path);
+/// Throws InputError("<file>:<line>:<col>: <what is wrong>; <what to do>"). Files are read within `limits`.
+Case load_case(const std::string& path, const ReaderLimits& limits = {});
 
 /// Parses a case from text (for tests and host codes); `name` is used in messages as the file name.
-Case parse_case(const std::string& text, const std::string& name, const std::string& dir = ".");
+Case parse_case(const std::string& text, const std::string& name, const std::string& dir = ".",
+                const ReaderLimits& limits = {});
 
 /// A case whose model is built in memory (by a host code, or from Python): `text` (YAML or JSON) holds the
 /// other sections (name, description, analysis, detect, update, test, discover; no model:), parsed against
 /// `model` (finalized) with every check and message of a case file; `name` names the text in messages and
 /// relative paths in it resolve against `dir`.
-Case case_with_model(Model model, const std::string& text, const std::string& name, const std::string& dir = ".");
+Case case_with_model(Model model, const std::string& text, const std::string& name, const std::string& dir = ".",
+                     const ReaderLimits& limits = {});
 
 /// The changed state of a detect: case: measured data from its file, or the exact modes of the changed model at
 /// the measured DOFs (then *changed, unless null, receives that model, for DetectOptions::simulated_changed).

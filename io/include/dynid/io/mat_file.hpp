@@ -14,6 +14,7 @@
 
 #include "dynid/engine/modal_data.hpp"
 #include "dynid/engine/recording.hpp"
+#include "dynid/io/limits.hpp"
 #include "dynid/io/matrix_model.hpp"
 #include "dynid/solvers/sparse.hpp"
 
@@ -22,13 +23,15 @@ namespace dynid {
 /// An open .mat file (read only). Not thread-safe: one object per thread.
 class MatFile {
  public:
-  /// Opens `path`; throws InputError if it is missing or not a MATLAB file.
-  explicit MatFile(const std::string& path);
+  /// Opens `path`; throws InputError if it is missing or not a MATLAB file. Variables of more than
+  /// `limits.max_mat_elements` elements are refused when read.
+  explicit MatFile(const std::string& path, const ReaderLimits& limits = {});
   ~MatFile();
   MatFile(const MatFile&) = delete;
   MatFile& operator=(const MatFile&) = delete;
 
   const std::string& path() const { return path_; }
+  const ReaderLimits& limits() const { return limits_; }
   /// "MATLAB 5.0 (v5/v7)", "MATLAB 7.3 (HDF5)" or "MATLAB 4".
   std::string version() const;
 
@@ -61,6 +64,7 @@ class MatFile {
  private:
   struct Handle;
   std::string path_;
+  ReaderLimits limits_;
   std::unique_ptr<Handle> h_;
 };
 
@@ -81,7 +85,9 @@ struct MatModelNames {
 /// Reads the model's matrices. Without a DOF table each equation becomes DOF ux of its own node (ids 1..n) at
 /// the origin, and a note says so: modal analysis, detection on elements and updating of groups work, but
 /// plots and geometric discovery candidates mean nothing.
-MatrixModelData read_mat_matrix_model(const MatModelNames& names, std::vector<std::string>* notes = nullptr);
+/// Elements beyond `limits.max_element_dofs` DOFs are refused.
+MatrixModelData read_mat_matrix_model(const MatModelNames& names, std::vector<std::string>* notes = nullptr,
+                                      const ReaderLimits& limits = {});
 
 /// Variable names of a recording ("data" channels x samples, "fs" Hz, optional "channels" labels).
 struct MatRecordingNames {
@@ -94,7 +100,7 @@ struct MatRecordingNames {
   std::vector<std::string> inputs;    ///< labels of the channels that are input forces
   std::string quantity = "acceleration";  ///< of the other channels
 };
-Recording read_mat_recording(const MatRecordingNames& names);
+Recording read_mat_recording(const MatRecordingNames& names, const ReaderLimits& limits = {});
 
 /// Variable names of modal data ("frequency_hz" or "eigenvalues" (rad/s)^2, "shapes" DOFs x modes, "dofs").
 struct MatModalNames {
@@ -111,6 +117,6 @@ struct MatModalNames {
   std::string shape_std;              ///< optional std of each shape entry (DOFs x modes, units of `shapes`; 0 =
                                       ///< exact, the normalising entry), or one per mode (relative to its largest)
 };
-ModalData read_mat_modal_data(const MatModalNames& names);
+ModalData read_mat_modal_data(const MatModalNames& names, const ReaderLimits& limits = {});
 
 }  // namespace dynid

@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "dynid/io/limits.hpp"
 #include "dynid/solvers/sparse.hpp"
 
 namespace dynid {
@@ -13,9 +14,10 @@ namespace dynid {
 void write_matrix_market(const std::string& path, const SparseMatrix& A, bool symmetric, bool overwrite);
 
 /// Reads a Matrix Market "coordinate real|integer general|symmetric" file into full (both-triangle) storage.
-/// Duplicate entries are summed. Errors name the file and line.
-SparseMatrix read_matrix_market(const std::string& path);
+/// Duplicate entries are summed. Errors name the file and line. Sizes beyond `limits.max_matrix_dimension` are
+/// refused.
+SparseMatrix read_matrix_market(const std::string& path, const ReaderLimits& limits = {});
 /// The same, from a file's content held in memory; `name` names it in messages.
-SparseMatrix parse_matrix_market(const std::string& text, const std::string& name);
+SparseMatrix parse_matrix_market(const std::string& text, const std::string& name, const ReaderLimits& limits = {});
 
 }  // namespace dynid

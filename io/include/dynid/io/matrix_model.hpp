@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "dynid/io/limits.hpp"
 #include "dynid/mesh/model.hpp"
 #include "dynid/solvers/sparse.hpp"
 
@@ -51,7 +52,8 @@ struct ElementMatrices {
 
 /// Parses an element-matrices file held in memory; `name` names it in messages ("file:line: ...").
 /// `num_equations` bounds the equation numbers (rows of the DOF table).
-std::vector<ElementMatrices> parse_element_matrices(const std::string& text, const std::string& name, int num_equations);
+std::vector<ElementMatrices> parse_element_matrices(const std::string& text, const std::string& name, int num_equations,
+                                                    const ReaderLimits& limits = {});
 
 /// A matrix model held in memory: what the files of MatrixModelFiles hold once read, and what a MATLAB file
 /// (dynid/io/mat_file.hpp) or a Python host gives. Names in the `*_name` fields say where each part came from
@@ -76,12 +78,14 @@ struct MatrixModelData {
 /// Adds the nodes and Matrix elements of an in-memory matrix model to `model` (not finalized), as
 /// add_matrix_model(files) does: groups become dense elements on the equations they touch (at most
 /// ReaderLimits::max_element_dofs), and what K and M hold beyond the elements becomes a "remainder" element.
-void add_matrix_model(const MatrixModelData& data, Model* model, std::vector<std::string>* notes = nullptr);
+void add_matrix_model(const MatrixModelData& data, Model* model, std::vector<std::string>* notes = nullptr,
+                      const ReaderLimits& limits = {});
 
 /// Adds the nodes and Matrix elements of a matrix model to `model` (not finalized: the caller may add supports,
 /// springs, point masses, then finalize). Remarks (e.g. a remainder element) go to `notes` if not null. Throws
 /// InputError naming file and line for anything malformed or inconsistent.
-void add_matrix_model(const MatrixModelFiles& files, Model* model, std::vector<std::string>* notes = nullptr);
+void add_matrix_model(const MatrixModelFiles& files, Model* model, std::vector<std::string>* notes = nullptr,
+                      const ReaderLimits& limits = {});
 
 /// Writes `model` (finalized) as a matrix model into folder `dir` (created if missing): K.mtx, M.mtx (assembled,
 /// symmetric), dofs.csv, nodes.csv, elements.txt (one record per element) and model.yaml (the case-file model

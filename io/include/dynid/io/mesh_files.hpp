@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "dynid/io/limits.hpp"
 #include "dynid/mesh/model.hpp"
 
 namespace dynid {
@@ -66,14 +67,16 @@ struct MeshData {
 
 /// Reads a Gmsh .msh file (2.2 or 4.1, ASCII or binary). Throws InputError.
 MeshData read_gmsh(const std::string& path);
-/// Reads an Abaqus .inp file (the subset above). Throws InputError.
-MeshData read_abaqus(const std::string& path);
+/// Reads an Abaqus .inp file (the subset above). Throws InputError; a *NSET/*ELSET GENERATE line may make at most
+/// `limits.max_generated_ids` ids.
+MeshData read_abaqus(const std::string& path, const ReaderLimits& limits = {});
 /// Parses a Gmsh .msh file held in memory: `bytes` is its content, `name` names it in messages.
 MeshData parse_gmsh(const std::string& bytes, const std::string& name);
 /// Parses an Abaqus .inp file held in memory. *INCLUDE files are read from `include_dir`; with include_dir ""
 /// (the default) an *INCLUDE is an InputError, so that the result depends on `bytes` alone.
-MeshData parse_abaqus(const std::string& bytes, const std::string& name, const std::string& include_dir = "");
+MeshData parse_abaqus(const std::string& bytes, const std::string& name, const std::string& include_dir = "",
+                      const ReaderLimits& limits = {});
 /// Reads a mesh file by its extension: .msh (Gmsh) or .inp (Abaqus).
-MeshData read_mesh_file(const std::string& path);
+MeshData read_mesh_file(const std::string& path, const ReaderLimits& limits = {});
 
 }  // namespace dynid

@@ -37,6 +37,7 @@ void relabel_points(const std::map<int, int>& map, const std::string& source, Mo
 /// Measured modal data from a .json, UFF 55/2414 or .mat file (the variables `mat` names; UFF shape directions
 /// turned to global by the geometry file's coordinate systems); with a geometry file, relabelled to model nodes.
 ModalData read_measured_modal_data(const std::string& file, const GeometrySpec& geometry, const Model& model,
-                                   std::vector<std::string>* notes = nullptr, const MatModalNames& mat = MatModalNames());
+                                   std::vector<std::string>* notes = nullptr,
+                                   const MatModalNames& mat = MatModalNames(), const ReaderLimits& limits = {});
 
 }  // namespace dynid

@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "dynid/engine/recording.hpp"
+#include "dynid/io/limits.hpp"
 #include "dynid/io/uff.hpp"
 
 namespace dynid {
@@ -113,7 +114,8 @@ struct TestData {
   std::string how;         ///< for text tables: the rule that decided the kind, in words
 };
 /// `sample_rate_hz` > 0: text files have no time column (they are time histories). `kind` other than kAuto says
-/// what a text table holds.
-TestData read_test_data(const std::string& path, double sample_rate_hz = 0, TableKind kind = TableKind::kAuto);
+/// what a text table holds. `.mat` recordings are read within `limits`.
+TestData read_test_data(const std::string& path, double sample_rate_hz = 0, TableKind kind = TableKind::kAuto,
+                        const ReaderLimits& limits = {});
 
 }  // namespace dynid

@@ -36,6 +36,7 @@ struct TestSetOptions {
   /// FRF text tables: output and input DOF of each FRF (pair of columns, over the files in order), or one for
   /// all. Empty: FRF k is output point k (DOF "k ux") over one common reference "0ux", with a note.
   std::vector<MeasuredDof> frf_outputs, frf_inputs;
+  ReaderLimits limits;  ///< of the files read (read_test_data)
 };
 
 /// One test: the channels of one excitation set-up (a hammer location, a shaker run, an ambient run).
