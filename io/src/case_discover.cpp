@@ -248,8 +248,9 @@ void identify_recordings_for(const Case& c, std::vector<Recording> recs, Discove
   out->measured = out->identification.modal_data("identified from " + out->source);
   const Eigen::Index found = out->measured.num_modes();
   if (found < 2)
-    throw InputError(out->source + ": discover: identification (" + out->identification.method + ") found " + std::to_string(found) + " mode" +
-                     (found == 1 ? "" : "s") + " " + band_words + "; discovery needs at least 2. Longer records, more or "
+    throw InputError(out->source + ": discover: identification (" + out->identification.method + ") found " +
+                     std::to_string(found) + " mode" + (found == 1 ? "" : "s") + " " + band_words +
+                     "; discovery needs at least 2. Longer records, more or "
                      "better-placed sensors, or another band (discover: identify: band_hz: [lo, hi]) would help; "
                      "`dynid identify` on the same files lists the rejected poles and why.");
 }

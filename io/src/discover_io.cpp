@@ -152,7 +152,8 @@ std::string misfit_words(const DiscoverySummary& s) {
 std::string rivals_words(const DiscoverySummary& s) {
   std::string r;
   for (std::size_t k = 0; k < s.rivals.size(); ++k)
-    r += (k ? "; " : "") + s.rivals[k].description + " (ln Bayes factor " + format_number(s.rivals[k].log_evidence, 3) + ")";
+    r += (k ? "; " : "") + s.rivals[k].description + " (ln Bayes factor " + format_number(s.rivals[k].log_evidence, 3) +
+         ")";
   return r.empty() ? "the other explanations scored" : r;
 }
 
@@ -179,8 +180,8 @@ std::string discovery_explanation(const DiscoverySummary& s) {
              "). An effect outside the library, or several at once, is likely.";
     case VerdictReason::kRivals:
       return "The model misses something, but the data cannot tell which: the best explanation, " + findings_words(s) +
-             " (ln Bayes factor " + format_number(s.combined.log_evidence, 3) + "; " + fit_words(s) + "), has a probability of only " +
-             pct(s.probability) + " % against " + rivals_words(s) +
+             " (ln Bayes factor " + format_number(s.combined.log_evidence, 3) + "; " + fit_words(s) +
+             "), has a probability of only " + pct(s.probability) + " % against " + rivals_words(s) +
              ". More modes, or sensors at the competing sites (rotations or strains there), would decide.";
     case VerdictReason::kExplained: {
       std::string w = "Missing physics: " + findings_words(s) + ". " + fit_words(s) + "; the findings remove " + pct(s.explained) +

@@ -119,7 +119,8 @@ namespace {
 
 // The localization's nature and mean frequency error from the screening (locate() gives the rest).
 void screening_nature(const Problem& p, const Screening& sc, Localization* L) {
-  L->mean_frequency_error_pct = 100.0 * ((sc.model_hz - p.data.frequencies_hz).array() / p.data.frequencies_hz.array()).mean();
+  L->mean_frequency_error_pct =
+      100.0 * ((sc.model_hz - p.data.frequencies_hz).array() / p.data.frequencies_hz.array()).mean();
   double best_k = 0, best_m = 0;
   for (std::size_t k = 0; k < p.library.size(); ++k) {
     if (p.library[k]->global()) continue;
@@ -154,7 +155,8 @@ void join_set(const std::vector<const Candidate*>& set, const std::vector<std::s
 std::vector<std::size_t> report_findings(const Problem& p, const Selection& sel, DiscoverySummary* S) {
   std::vector<std::size_t> order(sel.fit.set.size());
   std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return sel.importance[a] > sel.importance[b]; });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return sel.importance[a] > sel.importance[b]; });
   for (std::size_t k : order) {
     ScoredHypothesis h = score_fit(p, sel.fit, k, sel.chi2_best);
     h.log_evidence = sel.importance[k];
@@ -180,7 +182,8 @@ Equivalents name_equivalent_sites(const Problem& p, const Selection& sel, const 
   Equivalents equivalent;
   for (std::size_t k = 0; k < order.size(); ++k) {
     const Candidate* c = sel.fit.set[order[k]];
-    const auto own = std::find_if(singles.begin(), singles.end(), [&](const SetFit& f) { return f.ok && f.set[0] == c; });
+    const auto own =
+        std::find_if(singles.begin(), singles.end(), [&](const SetFit& f) { return f.ok && f.set[0] == c; });
     if (own == singles.end()) continue;
     const double le = log_evidence(p, *own);
     const ErrorScale es = error_scale(p, *own);
@@ -197,7 +200,8 @@ Equivalents name_equivalent_sites(const Problem& p, const Selection& sel, const 
       for (int id : g.set[0]->site().nodes)
         if (std::find(h.site.nodes.begin(), h.site.nodes.end(), id) == h.site.nodes.end()) h.site.nodes.push_back(id);
       for (int id : g.set[0]->site().elements)
-        if (std::find(h.site.elements.begin(), h.site.elements.end(), id) == h.site.elements.end()) h.site.elements.push_back(id);
+        if (std::find(h.site.elements.begin(), h.site.elements.end(), id) == h.site.elements.end())
+          h.site.elements.push_back(id);
     }
   }
   return equivalent;
@@ -216,7 +220,8 @@ void weigh_rivals(const Problem& p, const Selection& sel, const std::vector<SetF
   };
   auto other_story = [&](const std::vector<const Candidate*>& a) {
     for (const Candidate* x : a)
-      if (std::none_of(sel.fit.set.begin(), sel.fit.set.end(), [&](const Candidate* f) { return like(x, f); })) return true;
+      if (std::none_of(sel.fit.set.begin(), sel.fit.set.end(), [&](const Candidate* f) { return like(x, f); }))
+        return true;
     for (const Candidate* f : sel.fit.set)
       if (std::none_of(a.begin(), a.end(), [&](const Candidate* x) { return like(x, f); })) return true;
     return false;
@@ -246,8 +251,9 @@ void weigh_rivals(const Problem& p, const Selection& sel, const std::vector<SetF
     odds_against += std::exp(S->recalibration.log_evidence - best);
     if (S->recalibration.log_evidence >= best - p.options.ambiguity) S->rivals.push_back(S->recalibration);
   }
-  std::stable_sort(S->rivals.begin(), S->rivals.end(),
-                   [](const ScoredHypothesis& a, const ScoredHypothesis& b) { return a.log_evidence > b.log_evidence; });
+  std::stable_sort(S->rivals.begin(), S->rivals.end(), [](const ScoredHypothesis& a, const ScoredHypothesis& b) {
+    return a.log_evidence > b.log_evidence;
+  });
   S->probability = 1.0 / (1.0 + odds_against);
 }
 
