@@ -51,9 +51,11 @@ std::complex<double> pole_of(double f, double zeta) {
   return {-zeta * w, w * std::sqrt(std::max(0.0, 1 - zeta * zeta))};
 }
 
-std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<RawPole>>& orders, const std::vector<int>& order_of, double lo,
-                                               double hi, const IdentificationOptions& o, IdentificationSummary& s) {
-  // Step 1: the diagram, with hard flags (drawn) and continuous weights (used).
+namespace {
+// Step 1: the diagram (s.poles), with hard flags (drawn) and continuous weights (used); returns the poles with
+// weight, ascending in frequency.
+std::vector<Cand> weighted_poles(const std::vector<std::vector<RawPole>>& orders, const std::vector<int>& order_of, double lo, double hi,
+                                 const IdentificationOptions& o, IdentificationSummary& s) {
   std::vector<Cand> cand;
   for (std::size_t j = 0; j < orders.size(); ++j)
     for (std::size_t p = 0; p < orders[j].size(); ++p) {
@@ -90,8 +92,15 @@ std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<Raw
         cand.push_back({static_cast<int>(s.poles.size()), static_cast<int>(j), static_cast<int>(p), sp.frequency_hz, sp.weight});
       s.poles.push_back(sp);
     }
-  if (cand.empty()) return {};
   std::sort(cand.begin(), cand.end(), [](const Cand& a, const Cand& b) { return a.f < b.f || (a.f == b.f && a.pole < b.pole); });
+  return cand;
+}
+}  // namespace
+
+std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<RawPole>>& orders, const std::vector<int>& order_of, double lo,
+                                               double hi, const IdentificationOptions& o, IdentificationSummary& s) {
+  const std::vector<Cand> cand = weighted_poles(orders, order_of, lo, hi, o, s);
+  if (cand.empty()) return {};
   const double tol = o.cluster_tolerance;
   std::vector<double> fs(cand.size());
   for (std::size_t a = 0; a < cand.size(); ++a) fs[a] = cand[a].f;
