@@ -180,5 +180,38 @@ TEST(DetectErrors, ModesThatDoNotPairAndTooFewModes) {
   EXPECT_THROW(detect(c.model, none, DetectOptions{}), InputError);
 }
 
+TEST(DetectPairing, ModeTheSensorsCannotSeeIsNoPartner) {
+  // Issue 16: model modes the sensors barely see (mean square at the sensors below kMinPairingVisibility = 1 % of
+  // the mode's mean square over all translations, e.g. vertical bending of the floor beams under horizontal
+  // sensors) are no pairing partners: their MAC with any measurement is noise. A measured "mode" that is exactly
+  // such a mode's trace at the sensors (MAC 1 at its own frequency) is left unpaired with the warning; the sway
+  // modes pair. Exact modes, so the decision has no tolerance of its own.
+  const Case c = load_case(test::CasesDir() + "/paper-frame");
+  const std::vector<MeasuredDof> sensors = dofs_of_types(c.model, dof_bit(Dof::UX));
+  EigenOptions eo;
+  eo.num_modes = 30;
+  const ModalResult r = modal_analysis(c.model, eo);
+  const std::vector<int> rows = measured_equations(c.model, sensors), translations = translation_equations(c.model);
+  int hidden = -1;
+  for (Eigen::Index j = 0; j < r.eigenvalues.size() && hidden < 0; ++j) {
+    const double v = sensor_visibility(r.modes.col(j), rows, translations);
+    double trace = 0;
+    for (int e : rows) trace += r.modes(e, j) * r.modes(e, j);
+    if (!r.rigid_body[j] && v > 0 && v < kMinPairingVisibility && std::sqrt(trace) > 1e-6 * r.modes.col(j).norm()) hidden = static_cast<int>(j);
+  }
+  ASSERT_GE(hidden, 3) << "the frame has no mode its horizontal sensors barely see";
+  ModalData d = sample_modes(c.model, r, sensors, 0, 3, "sway modes");
+  const ModalData h = sample_modes(c.model, r, sensors, hidden, 1, "hidden mode");
+  d.frequencies_hz.conservativeResize(4);
+  d.shapes.conservativeResize(Eigen::NoChange, 4);
+  d.frequencies_hz[3] = h.frequencies_hz[0];
+  d.shapes.col(3) = h.shapes.col(0);
+  const DetectSummary s = detect(c.model, d, DetectOptions{});
+  bool unpaired = false;
+  for (const std::string& w : s.warnings) unpaired = unpaired || w.find("mode 4 (") != std::string::npos && w.find("pairs with no model mode") != std::string::npos;
+  EXPECT_TRUE(unpaired);
+  EXPECT_EQ(s.used_modes, (std::vector<int>{0, 1, 2}));
+}
+
 }  // namespace
 }  // namespace dynid

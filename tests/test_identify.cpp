@@ -12,6 +12,7 @@
 #include "dynid/mesh/generators.hpp"
 #include "dynid/io/case_file.hpp"
 #include "dynid/io/test_data.hpp"
+#include "internal/identify_select.hpp"
 #include "test_util.hpp"
 
 namespace dynid {
@@ -150,6 +151,59 @@ TEST(VirtualTest, WideBandCantileverLowestModesWithTheDefaultBandRule) {
   EXPECT_EQ(s.method, "lscf");
   std::printf("  band %.4g-%.4g Hz (f1 %.4g Hz), lines %.4g Hz\n", s.band_lo_hz, s.band_hi_hz, f1, s.resolution_hz);
   expect_identified(t.modes, s, 0, 1.01 * t.modes.frequencies_hz[1], kFreqTol, 0.3, kMinMac);
+}
+
+// Two clusters with one shape: the mode indicator's power response |H|^2 of 1 % damped modes on lines 0.0005
+// apart, and two candidates at 1 and 1.04 (4 % apart: beyond the half-power merge window max(3 %, zeta)).
+struct SplitPair {
+  Eigen::VectorXd f, power;
+  std::vector<internal::Candidate> cands;
+  std::vector<internal::IndicatorEvidence> ev;
+  IdentificationSummary s;
+  explicit SplitPair(bool second_resonance, double apart = 0.04, double zeta = 0.01) {
+    f = Eigen::VectorXd::LinSpaced(801, 0.8, 1.2);
+    power.resize(f.size());
+    auto resonance = [&](double x, double fr) { return 1 / (std::pow(1 - x * x / (fr * fr), 2) + std::pow(2 * zeta * x / fr, 2)); };
+    for (Eigen::Index k = 0; k < f.size(); ++k) power[k] = resonance(f[k], 1.0) + (second_resonance ? resonance(f[k], 1 + apart) : 0.0);
+    s.frequency_hz = f;
+    Eigen::VectorXcd shape(5);
+    shape << 1, 0.8, -0.3, 0.5, -1;
+    for (const auto& [fr, orders] : {std::pair<double, int>{1.0, 10}, std::pair<double, int>{1 + apart, 6}}) {
+      internal::Candidate c;
+      c.cluster.frequency_hz = fr;
+      c.cluster.damping_ratio = zeta;
+      for (int j = 0; j < orders; ++j) c.cluster.members.emplace_back(j, 0), c.cluster.member_weight.push_back(1.0);
+      c.cluster.poles = orders;
+      c.cluster.support = orders / 10.0;
+      c.strength = c.cluster.support;
+      c.shape = shape;
+      cands.push_back(c);
+      ev.push_back(internal::indicator_evidence(f, power, fr, zeta));
+    }
+  }
+  std::vector<std::vector<std::size_t>> check() { return internal::check_evidence(cands, ev, power, IdentificationOptions{}, 10, s); }
+};
+
+TEST(Selection, SecondReportOfAModeOnItsFlankIsMerged) {
+  // Issue 16: SSI reported some modes twice, 3-8 % apart with the same shape. One resonance: the indicator falls
+  // monotonically from the mode to the second report (no dip), so the second is a split of the first, merged.
+  SplitPair one(false);
+  const auto kept = one.check();
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_EQ(kept[0], (std::vector<std::size_t>{0, 1}));
+  ASSERT_EQ(one.s.rejected.size(), 1u);
+  EXPECT_EQ(one.s.rejected[0].reason, Rejection::kSplit);
+  EXPECT_NEAR(one.s.rejected[0].frequency_hz, 1.04, 1e-12);
+  // Two resonances 4 % apart (4 half-power half-bandwidths): the indicator dips 4.2 dB between them, beyond
+  // min_peak_db (3 dB), so two modes with one shape at these sensors stay two.
+  SplitPair two(true);
+  EXPECT_GT(internal::indicator_dip_db(two.f, two.power, 1.0, 1.04, 0.005), 3.5);
+  EXPECT_EQ(two.check().size(), 2u);
+  // Inside the half-power merge window (2.5 % < 3 %) too: two 0.5 % damped resonances dip 5.8 dB between them,
+  // so a close pair whose local shapes look alike (LSCF's local residues near a stronger neighbour) stays two.
+  SplitPair close(true, 0.025, 0.005);
+  EXPECT_GT(internal::indicator_dip_db(close.f, close.power, 1.0, 1.025, 0.0025), 3.5);
+  EXPECT_EQ(close.check().size(), 2u);
 }
 
 }  // namespace

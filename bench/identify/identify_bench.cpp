@@ -24,7 +24,8 @@
 //                   or not) within 2 % in frequency with MAC >= 0.8: a mode the structure does not have, or a
 //                   second report of one it has.
 //   damping error   |zeta_identified - zeta| / zeta of the found modes.
-// Seeds: dev 100000 + k (for tuning), test 200000 + k (for reporting), k = 0 .. count-1.
+// Seeds: dev 100000 + k (for tuning), test 200000 + k (for reporting), k = from .. from + count - 1. A block of test
+// seeds is reported once and then counts as development data: k = 0..59 (ident1, ident2), k = 60..119 (ident3).
 #include <fmt/core.h>
 
 #include <algorithm>

@@ -113,20 +113,6 @@ Eigen::VectorXd lambdas(const ModalData& d, const std::vector<int>& used) {
   return l;
 }
 
-// Restriction of a ModalData to some modes.
-ModalData select_modes(const ModalData& d, const std::vector<int>& used) {
-  ModalData o;
-  o.dofs = d.dofs;
-  o.source = d.source;
-  o.frequencies_hz.resize(static_cast<Eigen::Index>(used.size()));
-  o.shapes.resize(d.shapes.rows(), static_cast<Eigen::Index>(used.size()));
-  for (std::size_t k = 0; k < used.size(); ++k) {
-    o.frequencies_hz[static_cast<Eigen::Index>(k)] = d.frequencies_hz[used[k]];
-    o.shapes.col(static_cast<Eigen::Index>(k)) = d.shapes.col(used[k]);
-  }
-  return o;
-}
-
 // Residual forces R = (-K0 + lambda M0) phi of eigenpairs of (K, M) refined in extended precision
 // (refine_eigenpairs), formed in long double; phi scaled back to the given shapes, which the element fits use.
 Eigen::MatrixXd extended_residuals(const SparseMatrix& K, const SparseMatrix& M, const SparseMatrix& K0,
@@ -479,7 +465,7 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
     fo.frequency_noise = o.frequency_noise * (reference_measured ? std::sqrt(2.0) : 1.0);
     fo.shape_noise = o.shape_noise * (reference_measured ? std::sqrt(2.0) : 1.0);
     fo.min_mac = o.min_mac;
-    const ModalData used = select_modes(changed, pc.used);
+    const ModalData used = modes_subset(changed, pc.used);
     const Eigen::VectorXd theta0 = pm.nominal();
     Linearization L = linearize(pm, used, theta0, fo);
     S.chi2_unchanged = L.r.squaredNorm();
@@ -637,7 +623,7 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
         fo.objective = FitObjective::kFrequency;
         fo.frequency_noise = o.frequency_noise;
         fo.min_mac = o.min_mac;
-        fit = fit_parameters(pm, select_modes(changed, pc.used), start, mask, fo);
+        fit = fit_parameters(pm, modes_subset(changed, pc.used), start, mask, fo);
         theta_fit = fit.theta;
         have_fit = true;
       }

@@ -16,9 +16,6 @@
 namespace dynid {
 
 using internal::complex_mac;
-using internal::Candidate;
-using internal::PoleCluster;
-using internal::RawPole;
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
@@ -150,8 +147,8 @@ bool IdentificationOptions::IsValid(std::string* why) const {
   if (block_rows < 0 || decimate < 0) return fail("block rows and decimation must be >= 0");
   if (!(min_mpc >= 0 && min_mpc <= 1)) return fail("the MPC limit must be in [0, 1]");
   if (!std::isfinite(min_peak_db) || !(max_edge_db > 0)) return fail("the indicator peak limit must be finite and the edge limit > 0 dB");
-  if (!(merge_tolerance >= 0 && merge_tolerance < 0.5) || !(merge_mac > 0 && merge_mac <= 1))
-    return fail("the merge tolerance must be in [0, 0.5) and the merge MAC in (0, 1]");
+  if (!(merge_tolerance >= 0 && merge_tolerance < 0.5) || !(merge_span >= 0 && merge_span < 0.5) || !(merge_mac > 0 && merge_mac <= 1))
+    return fail("the merge tolerance and span must be in [0, 0.5) and the merge MAC in (0, 1]");
   if (segment < -1 || (segment > 0 && segment < 8)) return fail("the segment must be -1 (automatic), 0 (whole records) or >= 8 samples");
   if (!(exponential_end >= 0 && exponential_end < 1)) return fail("the exponential window end must be in [0, 1)");
   return true;
@@ -241,73 +238,99 @@ ModalData IdentificationSummary::modal_data(const std::string& source) const {
   return d;
 }
 
-IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationOptions& o) {
-  check_band(o);
-  const auto t0 = Clock::now();
-  frf_in.validate("LSCF: " + frf_in.source);
-  // Shapes are residues of the receptance; poles do not depend on the quantity.
+namespace {
+
+// ---- LSCF stages ----------------------------------------------------------------------------------------------
+
+// The FRFs in the band as LSCF fits them (receptance when every output is a motion: shapes are residues of the
+// receptance, poles do not depend on the quantity), and the model orders.
+struct LscfInput {
+  FrfData frf;
+  Eigen::VectorXd w;   // rad/s of the lines in the band
+  Eigen::MatrixXcd H;  // FRFs at those lines
+  double lo = 0, hi = 0, top = 0;  // band; frequency of the highest line in it
+  int ni = 0, no = 0, pmin = 0, pmax = 0, step = 1;
+};
+
+LscfInput lscf_input(const FrfData& frf_in, const IdentificationOptions& o) {
+  LscfInput in;
   bool motion = true;
   for (const Channel& c : frf_in.outputs)
     motion = motion && (c.quantity == Quantity::kDisplacement || c.quantity == Quantity::kVelocity || c.quantity == Quantity::kAcceleration) &&
              c.quantity == frf_in.outputs[0].quantity;
-  const FrfData frf = motion ? convert_frf(frf_in, Quantity::kDisplacement) : frf_in;
-  const double lo = std::max(o.band_lo_hz, 0.0), hi = o.band_hi_hz > 0 ? o.band_hi_hz : frf.frequency_hz[frf.frequency_hz.size() - 1];
+  in.frf = motion ? convert_frf(frf_in, Quantity::kDisplacement) : frf_in;
+  const FrfData& frf = in.frf;
+  in.lo = std::max(o.band_lo_hz, 0.0);
+  in.hi = o.band_hi_hz > 0 ? o.band_hi_hz : frf.frequency_hz[frf.frequency_hz.size() - 1];
   std::vector<Eigen::Index> lines;
   for (Eigen::Index k = 0; k < frf.frequency_hz.size(); ++k)
-    if (frf.frequency_hz[k] > 0 && frf.frequency_hz[k] >= lo && frf.frequency_hz[k] <= hi) lines.push_back(k);
+    if (frf.frequency_hz[k] > 0 && frf.frequency_hz[k] >= in.lo && frf.frequency_hz[k] <= in.hi) lines.push_back(k);
   const Eigen::Index nf = static_cast<Eigen::Index>(lines.size());
-  const int ni = frf.num_inputs(), no = frf.num_outputs();
+  in.ni = frf.num_inputs(), in.no = frf.num_outputs();
   // Orders not given: up to 60 / inputs, but no more than the band's lines support (a narrow band of a short
   // record); orders given are kept or refused.
-  int pmax = o.max_order > 0 ? o.max_order : std::max(10, 60 / ni);
-  const int pmin = o.min_order > 0 ? o.min_order : 2;
-  if (o.max_order == 0) pmax = std::min(pmax, static_cast<int>(nf / 2) - 1);
-  const int step = o.order_step > 0 ? o.order_step : 1;
-  if (nf < 2 * (pmax + 1) || pmax < std::max(pmin + 2, 6))
-    throw InputError("LSCF: " + std::to_string(nf) + " frequency lines in the band are too few for order " + std::to_string(std::max(pmax, 6)) +
+  in.pmax = o.max_order > 0 ? o.max_order : std::max(10, 60 / in.ni);
+  in.pmin = o.min_order > 0 ? o.min_order : 2;
+  if (o.max_order == 0) in.pmax = std::min(in.pmax, static_cast<int>(nf / 2) - 1);
+  in.step = o.order_step > 0 ? o.order_step : 1;
+  if (nf < 2 * (in.pmax + 1) || in.pmax < std::max(in.pmin + 2, 6))
+    throw InputError("LSCF: " + std::to_string(nf) + " frequency lines in the band are too few for order " + std::to_string(std::max(in.pmax, 6)) +
                      ": widen the band or use longer records (finer frequency lines)");
-
-  IdentificationSummary s;
-  s.method = "lscf";
-  for (const Channel& c : frf.outputs) s.dofs.push_back(c.dof);
-  s.min_order = pmin;
-  s.max_order = pmax;
-  s.window_decay_removed = frf.window_decay;
-  Eigen::VectorXd w(nf);
-  Eigen::MatrixXcd H(nf, frf.H.cols());
+  in.w.resize(nf);
+  in.H.resize(nf, frf.H.cols());
   for (Eigen::Index k = 0; k < nf; ++k) {
-    w[k] = 2 * kPi * frf.frequency_hz[lines[k]];
-    H.row(k) = frf.H.row(lines[k]);
+    in.w[k] = 2 * kPi * frf.frequency_hz[lines[k]];
+    in.H.row(k) = frf.H.row(lines[k]);
   }
-  s.band_lo_hz = lo;
-  s.band_hi_hz = hi;
-  s.resolution_hz = frf_in.frequency_hz.size() > 1 ? (frf_in.frequency_hz[frf_in.frequency_hz.size() - 1] - frf_in.frequency_hz[0]) / static_cast<double>(frf_in.frequency_hz.size() - 1) : 0;
-  // CMIF: the first singular value of the outputs x inputs FRF matrix at every line.
-  s.frequency_hz = frf_in.frequency_hz;
-  s.background.resize(frf_in.frequency_hz.size());
-  for (Eigen::Index k = 0; k < frf_in.frequency_hz.size(); ++k) {
-    Eigen::MatrixXcd Hk(no, ni);
-    for (int i = 0; i < ni; ++i)
-      for (int oo = 0; oo < no; ++oo) Hk(oo, i) = frf_in.H(k, oo + i * no);
-    s.background[k] = ni == 1 ? Hk.norm() : Eigen::JacobiSVD<Eigen::MatrixXcd>(Hk).singularValues()[0];
-  }
-  s.background_label = "CMIF (first singular value of the FRFs)";
+  in.top = frf.frequency_hz[lines.back()];
+  return in;
+}
 
-  // Basis z^r on the unit circle, dt = 1 / (2 f_top). The normal-equation blocks are Toeplitz in the degree:
-  //   R[r, s] = Re c(s - r),  S_o[r, (s, j)] = -Re h_oj(s - r),  T_o[(r, i), (s, j)] = Re g_oij(s - r),
-  // with c(d) = sum_k z_k^d, h_oj(d) = sum_k H_oj z_k^d, g_oij(d) = sum_k conj(H_oi) H_oj z_k^d, so only their
-  // 2P - 1 diagonals are summed over the frequency lines (O(nf P) per block instead of O(nf P^2)).
-  const double dt = 1.0 / (2 * frf.frequency_hz[lines.back()]);
-  const int P = pmax + 1, D = 2 * P - 1;
+// Column c = o + i * no of an FRF row (or of a residue row) as the outputs x inputs matrix.
+Eigen::MatrixXcd outputs_by_inputs(const Eigen::Ref<const Eigen::RowVectorXcd>& row, int no, int ni) {
+  Eigen::MatrixXcd M(no, ni);
+  for (int i = 0; i < ni; ++i)
+    for (int oo = 0; oo < no; ++oo) M(oo, i) = row[oo + i * no];
+  return M;
+}
+
+// CMIF: the first singular value of the outputs x inputs FRF matrix at every line.
+Eigen::VectorXd cmif(const FrfData& frf) {
+  const int ni = frf.num_inputs(), no = frf.num_outputs();
+  Eigen::VectorXd out(frf.frequency_hz.size());
+  for (Eigen::Index k = 0; k < frf.frequency_hz.size(); ++k) {
+    const Eigen::MatrixXcd Hk = outputs_by_inputs(frf.H.row(k), no, ni);
+    out[k] = ni == 1 ? Hk.norm() : Eigen::JacobiSVD<Eigen::MatrixXcd>(Hk).singularValues()[0];
+  }
+  return out;
+}
+
+// The reduced normal equations of LSCF at the largest order. Basis z^r on the unit circle, dt = 1 / (2 f_top).
+// The blocks are Toeplitz in the degree:
+//   R[r, s] = Re c(s - r),  S_o[r, (s, j)] = -Re h_oj(s - r),  T_o[(r, i), (s, j)] = Re g_oij(s - r),
+// with c(d) = sum_k z_k^d, h_oj(d) = sum_k H_oj z_k^d, g_oij(d) = sum_k conj(H_oi) H_oj z_k^d, so only their
+// 2P - 1 diagonals are summed over the frequency lines (O(nf P) per block instead of O(nf P^2)).
+struct LscfNormal {
+  double dt = 0;
+  Eigen::MatrixXd R;
+  std::vector<Eigen::MatrixXd> S, T;
+};
+
+LscfNormal lscf_normal_equations(const LscfInput& in) {
+  const Eigen::Index nf = in.w.size();
+  const int ni = in.ni, no = in.no;
+  LscfNormal ne;
+  ne.dt = 1.0 / (2 * in.top);
+  const int P = in.pmax + 1, D = 2 * P - 1;
   Eigen::MatrixXcd Z(D, nf);  // Z(d + P - 1, k) = z_k^d
   for (Eigen::Index k = 0; k < nf; ++k)
-    for (int d = -(P - 1); d <= P - 1; ++d) Z(d + P - 1, k) = std::exp(std::complex<double>(0, w[k] * dt * d));
+    for (int d = -(P - 1); d <= P - 1; ++d) Z(d + P - 1, k) = std::exp(std::complex<double>(0, in.w[k] * ne.dt * d));
   Eigen::MatrixXcd sums(nf, 1 + no * (ni + ni * ni));  // columns: 1, then per output H_oj and conj(H_oi) H_oj
   sums.col(0).setOnes();
   for (int oo = 0; oo < no; ++oo) {
     // Output o's row of H, weighted by 1 / its RMS so every output counts alike.
     Eigen::MatrixXcd Ho(nf, ni);
-    for (int i = 0; i < ni; ++i) Ho.col(i) = H.col(oo + i * no);
+    for (int i = 0; i < ni; ++i) Ho.col(i) = in.H.col(oo + i * no);
     const double rms = std::sqrt(Ho.squaredNorm() / static_cast<double>(Ho.size()));
     if (rms > 0) Ho /= rms;
     const int base = 1 + oo * (ni + ni * ni);
@@ -317,101 +340,232 @@ IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationO
   }
   const Eigen::MatrixXd diag = (Z * sums).real();  // D x columns
   auto at = [&](int col, int d) { return diag(d + P - 1, col); };
-  Eigen::MatrixXd R(P, P);
+  ne.R.resize(P, P);
   for (int r = 0; r < P; ++r)
-    for (int c = 0; c < P; ++c) R(r, c) = at(0, c - r);
-  std::vector<Eigen::MatrixXd> S(static_cast<std::size_t>(no), Eigen::MatrixXd(P, P * ni)), T(static_cast<std::size_t>(no), Eigen::MatrixXd(P * ni, P * ni));
+    for (int c = 0; c < P; ++c) ne.R(r, c) = at(0, c - r);
+  ne.S.assign(static_cast<std::size_t>(no), Eigen::MatrixXd(P, P * ni));
+  ne.T.assign(static_cast<std::size_t>(no), Eigen::MatrixXd(P * ni, P * ni));
   for (int oo = 0; oo < no; ++oo) {
     const int base = 1 + oo * (ni + ni * ni);
     for (int r = 0; r < P; ++r)
       for (int c = 0; c < P; ++c)
         for (int j = 0; j < ni; ++j) {
-          S[oo](r, c * ni + j) = -at(base + j, c - r);
-          for (int i = 0; i < ni; ++i) T[oo](r * ni + i, c * ni + j) = at(base + ni + i * ni + j, c - r);
+          ne.S[oo](r, c * ni + j) = -at(base + j, c - r);
+          for (int i = 0; i < ni; ++i) ne.T[oo](r * ni + i, c * ni + j) = at(base + ni + i * ni + j, c - r);
         }
   }
-  std::vector<std::vector<RawPole>> orders;
-  std::vector<int> order_of;
-  for (int p = pmin; p <= pmax; p += step) {
+  return ne;
+}
+
+// The poles of every order: the denominator alpha (alpha_p = I) from the reduced normal equations, its
+// companion matrix (left eigenvectors of the right fraction: participation vectors), the window's decay removed.
+internal::OrderPoles lscf_poles(const LscfInput& in, const LscfNormal& ne, double window_decay) {
+  const int ni = in.ni;
+  internal::OrderPoles out;
+  for (int p = in.pmin; p <= in.pmax; p += in.step) {
     const int q = (p + 1) * ni;
     Eigen::MatrixXd M = Eigen::MatrixXd::Zero(q, q);
-    const Eigen::LDLT<Eigen::MatrixXd> Rl(R.topLeftCorner(p + 1, p + 1));
-    for (int oo = 0; oo < no; ++oo) {
-      const Eigen::MatrixXd Sp = S[oo].topLeftCorner(p + 1, q);
-      M += T[oo].topLeftCorner(q, q) - Sp.transpose() * Rl.solve(Sp);
+    const Eigen::LDLT<Eigen::MatrixXd> Rl(ne.R.topLeftCorner(p + 1, p + 1));
+    for (int oo = 0; oo < in.no; ++oo) {
+      const Eigen::MatrixXd Sp = ne.S[oo].topLeftCorner(p + 1, q);
+      M += ne.T[oo].topLeftCorner(q, q) - Sp.transpose() * Rl.solve(Sp);
     }
-    // alpha_p = I: alpha_{0..p-1} = -Maa^-1 Mab.
     const int a = p * ni;
     const Eigen::MatrixXd alpha = -M.topLeftCorner(a, a).ldlt().solve(M.topRightCorner(a, ni));
-    // Companion matrix of sum_r alpha_r^T z^r (left eigenvectors of the right fraction: participation).
     Eigen::MatrixXd C = Eigen::MatrixXd::Zero(a, a);
     for (int r = 0; r < p; ++r) C.block(0, (p - 1 - r) * ni, ni, ni) = -alpha.block(r * ni, 0, ni, ni).transpose();
     if (p > 1) C.bottomLeftCorner(a - ni, a - ni).setIdentity();
-    Eigen::EigenSolver<Eigen::MatrixXd> es(C);
-    std::vector<RawPole> poles;
-    if (es.info() == Eigen::Success)
-      for (int k = 0; k < a; ++k) {
-        const std::complex<double> z = es.eigenvalues()[k];
-        if (z.imag() <= 0 || std::abs(z) == 0) continue;
-        RawPole rp;
-        rp.lambda = std::log(z) / dt + frf.window_decay;
-        rp.vec = es.eigenvectors().col(k).tail(ni);
-        poles.push_back(rp);
-      }
-    orders.push_back(std::move(poles));
-    order_of.push_back(p);
+    Eigen::MatrixXd participation = Eigen::MatrixXd::Zero(ni, a);
+    participation.rightCols(ni).setIdentity();
+    out.poles.push_back(internal::discrete_poles(C, ne.dt, window_decay, participation));
+    out.order.push_back(p);
   }
-  // Selection: clusters, shapes of those with support (LSFD at all of them), evidence, then LSFD at the modes.
-  const std::vector<PoleCluster> clusters = internal::stabilize_and_cluster(orders, order_of, lo, hi, o, s);
-  auto residues = [&](const std::vector<std::complex<double>>& poles) {
-    // Per pole, the outputs x inputs residue matrix of the receptance.
-    std::vector<Eigen::MatrixXcd> out;
-    if (poles.empty()) return out;
-    const Eigen::MatrixXcd res = lsfd(w, H, poles);
-    for (std::size_t r = 0; r < poles.size(); ++r) {
-      Eigen::MatrixXcd Rr(no, ni);
-      for (int i = 0; i < ni; ++i)
-        for (int oo = 0; oo < no; ++oo) Rr(oo, i) = res(static_cast<Eigen::Index>(r), oo + i * no);
-      out.push_back(Rr);
+  return out;
+}
+
+Eigen::VectorXcd principal(const Eigen::MatrixXcd& Rr) {
+  Eigen::JacobiSVD<Eigen::MatrixXcd> svd(Rr, Eigen::ComputeThinU);
+  return svd.matrixU().col(0) * svd.singularValues()[0];
+}
+
+// A cluster's shape for the evidence checks: the principal vector of its residues from the lines around it.
+Eigen::VectorXcd lscf_cluster_shape(const LscfInput& in, const internal::PoleCluster& c, double window_decay, double resolution_hz) {
+  const double zw = c.damping_ratio + window_decay / (2 * kPi * c.frequency_hz);
+  const std::complex<double> pw = internal::pole_of(c.frequency_hz, c.damping_ratio) - window_decay;
+  const Eigen::VectorXcd R = local_residues(in.w, in.H, pw, std::max(3 * zw * std::abs(pw), 5 * 2 * kPi * resolution_hz));
+  return principal(outputs_by_inputs(R.transpose(), in.no, in.ni));
+}
+
+// LSFD at the modes' poles of the windowed data (the window's decay put back): shapes and contributions.
+void lscf_mode_shapes(const LscfInput& in, double window_decay, IdentificationSummary& s) {
+  if (s.modes.empty()) return;
+  std::vector<std::complex<double>> poles;
+  for (const IdentifiedMode& m : s.modes) poles.push_back(internal::pole_of(m.frequency_hz, m.damping_ratio) - window_decay);
+  const Eigen::MatrixXcd res = lsfd(in.w, in.H, poles);
+  double top = 0;
+  for (std::size_t r = 0; r < s.modes.size(); ++r) {
+    const Eigen::MatrixXcd Rr = outputs_by_inputs(res.row(static_cast<Eigen::Index>(r)), in.no, in.ni);
+    s.modes[r].shape = principal(Rr);
+    finish_shape(s.modes[r]);
+    s.modes[r].contribution = Rr.norm() / std::abs(poles[r].real());
+    top = std::max(top, s.modes[r].contribution);
+  }
+  for (IdentifiedMode& m : s.modes) m.contribution = top > 0 ? m.contribution / top : 0;
+  mark_twins(s.modes, true);
+}
+
+// ---- SSI-cov stages -------------------------------------------------------------------------------------------
+
+struct SsiSetup {
+  std::vector<int> outs;
+  int l = 0, dec = 1, nmin = 2, nmax = 80, step = 2, i = 0;  // outputs, decimation, orders, block rows
+  double fs = 0, lo = 0, hi = 0, flow = 0;                  // decimated rate, band, lowest frequency of interest
+};
+
+SsiSetup ssi_setup(const Recording& rec, const IdentificationOptions& o) {
+  SsiSetup u;
+  u.outs = rec.output_channels();
+  u.l = static_cast<int>(u.outs.size());
+  if (u.l < 1) throw InputError("SSI: " + rec.source + " has no output channels");
+  const double fs0 = rec.sample_rate_hz;
+  u.hi = o.band_hi_hz > 0 ? o.band_hi_hz : 0.4 * fs0;
+  if (u.hi > fs0 / 2) throw InputError("SSI: the band's top is above the Nyquist frequency " + std::to_string(fs0 / 2) + " Hz");
+  u.dec = o.decimate > 0 ? o.decimate : std::max(1, static_cast<int>(std::floor(fs0 / (2.5 * u.hi))));
+  u.fs = fs0 / u.dec;
+  u.lo = o.band_lo_hz;
+  u.nmax = o.max_order > 0 ? o.max_order : 80;
+  u.nmin = o.min_order > 0 ? o.min_order : 2;
+  u.step = o.order_step > 0 ? o.order_step : 2;
+  u.flow = u.lo > 0 ? u.lo : u.fs / 100;
+  const int l = u.l;
+  u.i = o.block_rows > 0 ? o.block_rows : std::max((u.nmax + l - 1) / l + 2, static_cast<int>(std::ceil(u.fs / u.flow)));
+  u.i = std::min(u.i, std::max((u.nmax + l - 1) / l + 2, 1500 / l));
+  if ((u.i - 1) * l < u.nmax)
+    throw InputError("SSI: (block rows - 1) x outputs (" + std::to_string((u.i - 1) * l) + ") must reach the maximum order " + std::to_string(u.nmax) +
+                     "; raise the block rows or lower the order");
+  return u;
+}
+
+// The output channels of every record, each demeaned and decimated.
+std::vector<Eigen::MatrixXd> ssi_records(const Recording& rec, const SsiSetup& u) {
+  std::vector<Eigen::MatrixXd> out;
+  for (const Eigen::MatrixXd& x : rec.records) {
+    Eigen::MatrixXd y(x.rows(), u.l);
+    for (int c = 0; c < u.l; ++c) y.col(c) = x.col(u.outs[c]).array() - x.col(u.outs[c]).mean();
+    y = decimate(y, u.dec);
+    if (y.rows() <= 4 * u.i)
+      throw InputError("SSI: a record of " + rec.source + " has too few samples (" + std::to_string(y.rows()) + " after decimation) for " +
+                       std::to_string(u.i) + " block rows");
+    out.push_back(std::move(y));
+  }
+  return out;
+}
+
+// Correlations R_k = E[y_{t+k} y_t^T], k = 0..2i, pooled over records; the block Toeplitz T(a, b) = R_{i + a - b}.
+Eigen::MatrixXd ssi_toeplitz(const std::vector<Eigen::MatrixXd>& records, const SsiSetup& u) {
+  const int i = u.i, l = u.l;
+  std::vector<Eigen::MatrixXd> Rk(static_cast<std::size_t>(2 * i + 1), Eigen::MatrixXd::Zero(l, l));
+  Eigen::VectorXd weight = Eigen::VectorXd::Zero(2 * i + 1);
+  for (const Eigen::MatrixXd& y : records) {
+    const std::vector<Eigen::MatrixXd> r = correlations(y, 2 * i);
+    for (int k = 0; k <= 2 * i; ++k) {
+      const double n = static_cast<double>(y.rows() - k);
+      Rk[k] += n * r[k];
+      weight[k] += n;
     }
-    return out;
-  };
-  auto principal = [](const Eigen::MatrixXcd& Rr) -> Eigen::VectorXcd {
-    Eigen::JacobiSVD<Eigen::MatrixXcd> svd(Rr, Eigen::ComputeThinU);
-    return svd.matrixU().col(0) * svd.singularValues()[0];
-  };
-  std::vector<Candidate> cands(clusters.size());
-  std::vector<internal::IndicatorEvidence> peak(clusters.size());
-  for (std::size_t c = 0; c < clusters.size(); ++c) {
-    cands[c].cluster = clusters[c];
-    cands[c].strength = clusters[c].support;
-    // The windowed data's peaks are wider by the window's decay.
-    const double zw = clusters[c].damping_ratio + frf.window_decay / (2 * kPi * clusters[c].frequency_hz);
-    peak[c] = internal::indicator_evidence(s.frequency_hz, s.background.cwiseAbs2(), clusters[c].frequency_hz, zw);
-    if (clusters[c].support < internal::kShapedShare * o.min_cluster_fraction) continue;
-    const std::complex<double> pw = internal::pole_of(clusters[c].frequency_hz, clusters[c].damping_ratio) - frf.window_decay;
-    const Eigen::VectorXcd R = local_residues(w, H, pw, std::max(3 * zw * std::abs(pw), 5 * 2 * kPi * s.resolution_hz));
-    Eigen::MatrixXcd Rr(no, ni);
-    for (int i = 0; i < ni; ++i)
-      for (int oo = 0; oo < no; ++oo) Rr(oo, i) = R[oo + i * no];
-    cands[c].shape = principal(Rr);
   }
-  internal::make_modes(cands, peak, internal::check_evidence(cands, peak, o, orders.size(), s), orders.size(), s);
-  if (!s.modes.empty()) {
-    // LSFD at the modes' poles of the windowed data (the window's decay put back).
-    std::vector<std::complex<double>> poles;
-    for (const IdentifiedMode& m : s.modes) poles.push_back(internal::pole_of(m.frequency_hz, m.damping_ratio) - frf.window_decay);
-    const std::vector<Eigen::MatrixXcd> res = residues(poles);
-    double top = 0;
-    for (std::size_t r = 0; r < s.modes.size(); ++r) {
-      s.modes[r].shape = principal(res[r]);
-      finish_shape(s.modes[r]);
-      s.modes[r].contribution = res[r].norm() / std::abs(poles[r].real());
-      top = std::max(top, s.modes[r].contribution);
-    }
-    for (IdentifiedMode& m : s.modes) m.contribution = top > 0 ? m.contribution / top : 0;
-    mark_twins(s.modes, true);
+  for (int k = 0; k <= 2 * i; ++k) Rk[k] /= weight[k];
+  Eigen::MatrixXd Tm(i * l, i * l);
+  for (int a = 0; a < i; ++a)
+    for (int b = 0; b < i; ++b) Tm.block(a * l, b * l, l, l) = Rk[i + a - b];
+  return Tm;
+}
+
+// The poles of every order: A_n = pinv(O_up) O_down with O = U_n S_n^(1/2); from the leading n x n blocks of
+// G = U_up^T U_up and F = U_up^T U_down (computed once at the largest order), A_n = S^-1/2 G_n^-1 F_n S^1/2; the
+// shapes C psi with C the first block row of O.
+internal::OrderPoles ssi_poles(const Eigen::MatrixXd& Tm, const SsiSetup& u) {
+  const int i = u.i, l = u.l;
+  Eigen::MatrixXd U;
+  Eigen::VectorXd sv;
+  leading_svd(Tm, u.nmax, &U, &sv);
+  const Eigen::MatrixXd Uq = U.leftCols(u.nmax);
+  const Eigen::MatrixXd Gm = Uq.topRows((i - 1) * l).transpose() * Uq.topRows((i - 1) * l);
+  const Eigen::MatrixXd Fm = Uq.topRows((i - 1) * l).transpose() * Uq.bottomRows((i - 1) * l);
+  internal::OrderPoles out;
+  for (int n = u.nmin; n <= u.nmax; n += u.step) {
+    const Eigen::VectorXd sq = sv.head(n).cwiseSqrt();
+    const Eigen::MatrixXd A = sq.cwiseInverse().asDiagonal() * Gm.topLeftCorner(n, n).ldlt().solve(Fm.topLeftCorner(n, n)) * sq.asDiagonal();
+    const Eigen::MatrixXd C = Uq.topRows(l).leftCols(n) * sq.asDiagonal();
+    out.poles.push_back(internal::discrete_poles(A, 1.0 / u.fs, 0.0, C));
+    out.order.push_back(n);
   }
+  return out;
+}
+
+// Background and mode indicator: the first singular value of the output cross-spectral matrix (Welch, the
+// plan's resolution when given, else segments of 8 periods of the lowest frequency of interest).
+void output_spectrum_indicator(const std::vector<Eigen::MatrixXd>& records, const SsiSetup& u, const IdentificationOptions& o, IdentificationSummary& s) {
+  WelchOptions wo;
+  int seg = 8;
+  const Eigen::Index shortest = std::min_element(records.begin(), records.end(), [](const auto& a, const auto& b) { return a.rows() < b.rows(); })->rows();
+  if (o.segment > 0) {  // the plan's resolution, in decimated samples
+    while (seg * 2 <= shortest && seg * 2 <= o.segment / u.dec) seg *= 2;
+  } else {
+    while (seg * 2 <= shortest && seg < 8 * u.fs / u.flow && seg < (1 << 16)) seg *= 2;
+  }
+  wo.segment = seg;
+  const CrossSpectra G = welch(records, u.fs, wo);
+  s.frequency_hz = G.frequency;
+  s.resolution_hz = u.fs / seg;
+  s.background.resize(G.frequency.size());
+  for (Eigen::Index k = 0; k < G.frequency.size(); ++k)
+    s.background[k] = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXcd>(G.G[k], Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+  s.background_label = "first singular value of the output spectral matrix";
+}
+
+// A cluster's shape: the weighted mean of its poles' shapes, each turned to the strongest member's phase.
+Eigen::VectorXcd ssi_cluster_shape(const internal::OrderPoles& op, const internal::PoleCluster& pc) {
+  const std::size_t top = static_cast<std::size_t>(std::max_element(pc.member_weight.begin(), pc.member_weight.end()) - pc.member_weight.begin());
+  const Eigen::VectorXcd ref = op.poles[pc.members[top].first][pc.members[top].second].vec.normalized();
+  Eigen::VectorXcd sum = Eigen::VectorXcd::Zero(ref.size());
+  for (std::size_t m = 0; m < pc.members.size(); ++m) {
+    Eigen::VectorXcd v = op.poles[pc.members[m].first][pc.members[m].second].vec.normalized();
+    const std::complex<double> d = ref.dot(v);  // conj(ref) . v
+    if (std::abs(d) > 0) v *= std::conj(d) / std::abs(d);
+    sum += pc.member_weight[m] * v;
+  }
+  return sum;
+}
+
+}  // namespace
+
+IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationOptions& o) {
+  check_band(o);
+  const auto t0 = Clock::now();
+  frf_in.validate("LSCF: " + frf_in.source);
+  const LscfInput in = lscf_input(frf_in, o);
+  const double decay = in.frf.window_decay;
+  IdentificationSummary s;
+  s.method = "lscf";
+  for (const Channel& c : in.frf.outputs) s.dofs.push_back(c.dof);
+  s.min_order = in.pmin;
+  s.max_order = in.pmax;
+  s.window_decay_removed = decay;
+  s.band_lo_hz = in.lo;
+  s.band_hi_hz = in.hi;
+  const Eigen::Index nl = frf_in.frequency_hz.size();
+  s.resolution_hz = nl > 1 ? (frf_in.frequency_hz[nl - 1] - frf_in.frequency_hz[0]) / static_cast<double>(nl - 1) : 0;
+  s.frequency_hz = frf_in.frequency_hz;
+  s.background = cmif(frf_in);
+  s.background_label = "CMIF (first singular value of the FRFs)";
+
+  const internal::OrderPoles poles = lscf_poles(in, lscf_normal_equations(in), decay);
+  // Selection on the CMIF's power (the windowed data's peaks are wider by the window's decay), then LSFD at the
+  // selected poles for the shapes.
+  internal::select_modes(poles, in.lo, in.hi, o, s.background.cwiseAbs2(), decay,
+                         [&](const internal::PoleCluster& c) { return lscf_cluster_shape(in, c, decay, s.resolution_hz); }, s);
+  lscf_mode_shapes(in, decay, s);
   s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return s;
 }
@@ -420,126 +574,21 @@ IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOpt
   check_band(o);
   const auto t0 = Clock::now();
   rec.validate("SSI: " + rec.source);
-  const std::vector<int> outs = rec.output_channels();
-  const int l = static_cast<int>(outs.size());
-  if (l < 1) throw InputError("SSI: " + rec.source + " has no output channels");
-  const double fs0 = rec.sample_rate_hz;
-  const double hi = o.band_hi_hz > 0 ? o.band_hi_hz : 0.4 * fs0;
-  if (hi > fs0 / 2) throw InputError("SSI: the band's top is above the Nyquist frequency " + std::to_string(fs0 / 2) + " Hz");
-  const int dec = o.decimate > 0 ? o.decimate : std::max(1, static_cast<int>(std::floor(fs0 / (2.5 * hi))));
-  const double fs = fs0 / dec;
-  const double lo = o.band_lo_hz;
-  const int nmax = o.max_order > 0 ? o.max_order : 80;
-  const int nmin = o.min_order > 0 ? o.min_order : 2;
-  const int step = o.order_step > 0 ? o.order_step : 2;
-  const double flow = lo > 0 ? lo : fs / 100;
-  int i = o.block_rows > 0 ? o.block_rows : std::max((nmax + l - 1) / l + 2, static_cast<int>(std::ceil(fs / flow)));
-  i = std::min(i, std::max((nmax + l - 1) / l + 2, 1500 / l));
-  if ((i - 1) * l < nmax)
-    throw InputError("SSI: (block rows - 1) x outputs (" + std::to_string((i - 1) * l) + ") must reach the maximum order " + std::to_string(nmax) +
-                     "; raise the block rows or lower the order");
-
+  const SsiSetup u = ssi_setup(rec, o);
   IdentificationSummary s;
   s.method = "ssi";
-  for (int c : outs) s.dofs.push_back(rec.channels[c].dof);
-  s.min_order = nmin;
-  s.max_order = nmax;
+  for (int c : u.outs) s.dofs.push_back(rec.channels[c].dof);
+  s.min_order = u.nmin;
+  s.max_order = u.nmax;
+  s.band_lo_hz = u.lo;
+  s.band_hi_hz = u.hi;
 
-  // Correlations R_k = E[y_{t+k} y_t^T], k = 0..2i, pooled over records (each demeaned, decimated).
-  std::vector<Eigen::MatrixXd> Rk(static_cast<std::size_t>(2 * i + 1), Eigen::MatrixXd::Zero(l, l));
-  Eigen::VectorXd weight = Eigen::VectorXd::Zero(2 * i + 1);
-  std::vector<Eigen::MatrixXd> decimated;
-  for (const Eigen::MatrixXd& x : rec.records) {
-    Eigen::MatrixXd y(x.rows(), l);
-    for (int c = 0; c < l; ++c) y.col(c) = x.col(outs[c]).array() - x.col(outs[c]).mean();
-    y = decimate(y, dec);
-    if (y.rows() <= 4 * i) throw InputError("SSI: a record of " + rec.source + " has too few samples (" + std::to_string(y.rows()) + " after decimation) for " + std::to_string(i) + " block rows");
-    const std::vector<Eigen::MatrixXd> r = correlations(y, 2 * i);
-    for (int k = 0; k <= 2 * i; ++k) {
-      const double n = static_cast<double>(y.rows() - k);
-      Rk[k] += n * r[k];
-      weight[k] += n;
-    }
-    decimated.push_back(std::move(y));
-  }
-  for (int k = 0; k <= 2 * i; ++k) Rk[k] /= weight[k];
-  // Block Toeplitz T(a, b) = R_{i + a - b}, a, b = 0..i-1.
-  Eigen::MatrixXd Tm(i * l, i * l);
-  for (int a = 0; a < i; ++a)
-    for (int b = 0; b < i; ++b) Tm.block(a * l, b * l, l, l) = Rk[i + a - b];
-  Eigen::MatrixXd U;
-  Eigen::VectorXd sv;
-  leading_svd(Tm, nmax, &U, &sv);
-  // A_n = pinv(O_up) O_down with O = U_n S_n^(1/2): from the leading n x n blocks of G = U_up^T U_up and
-  // F = U_up^T U_down (computed once at the largest order), A_n = S^-1/2 G_n^-1 F_n S^1/2.
-  const Eigen::MatrixXd Uq = U.leftCols(nmax);
-  const Eigen::MatrixXd Gm = Uq.topRows((i - 1) * l).transpose() * Uq.topRows((i - 1) * l);
-  const Eigen::MatrixXd Fm = Uq.topRows((i - 1) * l).transpose() * Uq.bottomRows((i - 1) * l);
-  std::vector<std::vector<RawPole>> orders;
-  std::vector<int> order_of;
-  for (int n = nmin; n <= nmax; n += step) {
-    const Eigen::VectorXd sq = sv.head(n).cwiseSqrt();
-    const Eigen::MatrixXd A = sq.cwiseInverse().asDiagonal() * Gm.topLeftCorner(n, n).ldlt().solve(Fm.topLeftCorner(n, n)) * sq.asDiagonal();
-    const Eigen::MatrixXd O = Uq.topRows(l).leftCols(n) * sq.asDiagonal();
-    const Eigen::MatrixXd& Cm = O;
-    Eigen::EigenSolver<Eigen::MatrixXd> es(A);
-    std::vector<RawPole> poles;
-    if (es.info() == Eigen::Success)
-      for (int k = 0; k < n; ++k) {
-        const std::complex<double> mu = es.eigenvalues()[k];
-        if (mu.imag() <= 0 || std::abs(mu) == 0) continue;
-        RawPole rp;
-        rp.lambda = std::log(mu) * fs;
-        rp.vec = Cm * es.eigenvectors().col(k);
-        poles.push_back(rp);
-      }
-    orders.push_back(std::move(poles));
-    order_of.push_back(n);
-  }
-  // Background and mode indicator: first singular value of the output cross-spectral matrix.
-  WelchOptions wo;
-  int seg = 8;
-  const Eigen::Index shortest = std::min_element(decimated.begin(), decimated.end(), [](const auto& a, const auto& b) { return a.rows() < b.rows(); })->rows();
-  if (o.segment > 0) {  // the plan's resolution, in decimated samples
-    while (seg * 2 <= shortest && seg * 2 <= o.segment / dec) seg *= 2;
-  } else {
-    while (seg * 2 <= shortest && seg < 8 * fs / flow && seg < (1 << 16)) seg *= 2;
-  }
-  wo.segment = seg;
-  const CrossSpectra G = welch(decimated, fs, wo);
-  s.frequency_hz = G.frequency;
-  s.resolution_hz = fs / seg;
-  s.band_lo_hz = lo;
-  s.band_hi_hz = hi;
-  s.background.resize(G.frequency.size());
-  for (Eigen::Index k = 0; k < G.frequency.size(); ++k)
-    s.background[k] = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXcd>(G.G[k], Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
-  // Selection: clusters; a cluster's shape is the weighted mean of its poles' shapes (each turned to the
-  // strongest member's phase); evidence.
-  const std::vector<PoleCluster> clusters = internal::stabilize_and_cluster(orders, order_of, lo, hi, o, s);
-  std::vector<Candidate> cands(clusters.size());
-  std::vector<internal::IndicatorEvidence> peak(clusters.size());
-  for (std::size_t c = 0; c < clusters.size(); ++c) {
-    const PoleCluster& pc = clusters[c];
-    cands[c].cluster = pc;
-    cands[c].strength = pc.support;
-    peak[c] = internal::indicator_evidence(s.frequency_hz, s.background, pc.frequency_hz, pc.damping_ratio);
-    if (pc.support < internal::kShapedShare * o.min_cluster_fraction) continue;
-    const std::size_t top = static_cast<std::size_t>(std::max_element(pc.member_weight.begin(), pc.member_weight.end()) - pc.member_weight.begin());
-    const Eigen::VectorXcd ref = orders[pc.members[top].first][pc.members[top].second].vec.normalized();
-    Eigen::VectorXcd sum = Eigen::VectorXcd::Zero(ref.size());
-    for (std::size_t m = 0; m < pc.members.size(); ++m) {
-      Eigen::VectorXcd v = orders[pc.members[m].first][pc.members[m].second].vec.normalized();
-      const std::complex<double> d = ref.dot(v);  // conj(ref) . v
-      if (std::abs(d) > 0) v *= std::conj(d) / std::abs(d);
-      sum += pc.member_weight[m] * v;
-    }
-    cands[c].shape = sum;
-  }
-  internal::make_modes(cands, peak, internal::check_evidence(cands, peak, o, orders.size(), s), orders.size(), s);
+  const std::vector<Eigen::MatrixXd> records = ssi_records(rec, u);
+  const internal::OrderPoles poles = ssi_poles(ssi_toeplitz(records, u), u);
+  output_spectrum_indicator(records, u, o, s);
+  internal::select_modes(poles, u.lo, u.hi, o, s.background, 0.0, [&](const internal::PoleCluster& c) { return ssi_cluster_shape(poles, c); }, s);
   for (IdentifiedMode& m : s.modes) finish_shape(m);
   mark_twins(s.modes, false);
-  s.background_label = "first singular value of the output spectral matrix";
   s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return s;
 }

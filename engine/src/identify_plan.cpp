@@ -127,6 +127,20 @@ std::vector<double> band_peaks(const Spectrum& q, double top, std::vector<double
   return out;
 }
 
+// The highest frequency up to `top` where a force spectrum stands within 10 dB of its median level over
+// (0, top]: the end of a broadband excitation. 0 when there is no spectrum.
+double excitation_top(const Spectrum& q, double top) {
+  std::vector<double> levels;
+  for (Eigen::Index k = 1; k < q.level.size(); ++k)
+    if (q.f[k] <= top) levels.push_back(q.level[k]);
+  if (levels.empty()) return 0;
+  const double floor = 0.1 * percentile(levels, 0.5);
+  double edge = 0;
+  for (Eigen::Index k = 1; k < q.level.size(); ++k)
+    if (q.f[k] <= top && q.level[k] >= floor) edge = q.f[k];
+  return edge;
+}
+
 int pow2_at_most(double n) {
   int p = 8;
   while (2.0 * p <= n) p *= 2;
@@ -187,8 +201,20 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
     p.lowest_peak_hz = p.peaks_hz.front();
     p.lowest_peak_damping = widths.empty() ? 0 : widths.front() / (2 * p.lowest_peak_hz);
   }
-  // Band from the peaks, unless given.
-  if (o.band_hi_hz <= 0) band_from_peaks(p, 0.45 * fs);
+  // Band from the peaks, unless given; a measured broadband force shows where the excitation ends, and the top
+  // reaches it when the peaks' rule stops short of it (the highest modes' peaks stand less than 10 dB out).
+  if (o.band_hi_hz <= 0) {
+    band_from_peaks(p, 0.45 * fs);
+    if (!p.impulsive && any_input && p.band_from_data) {
+      const double edge = excitation_top(channel_spectrum(recs, false, segment, true), 0.45 * fs);
+      if (edge > p.band_hi_hz) {
+        p.band_hi_hz = edge;
+        char b[160];
+        std::snprintf(b, sizeof b, "band top %.4g Hz: where the measured force's spectrum ends (10 dB below its median)", edge);
+        p.notes.push_back(b);
+      }
+    }
+  }
   // Segment for continuous records: the lowest peak's half-power bandwidth over 4 lines.
   if (o.segment >= 0) {
     p.segment = o.segment;

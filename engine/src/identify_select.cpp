@@ -6,6 +6,8 @@
 #include <cmath>
 #include <map>
 
+#include <Eigen/Eigenvalues>
+
 namespace dynid::internal {
 
 namespace {
@@ -23,6 +25,21 @@ struct Cand {
 };
 }  // namespace
 
+std::vector<RawPole> discrete_poles(const Eigen::MatrixXd& A, double dt, double decay, const Eigen::MatrixXd& output) {
+  std::vector<RawPole> poles;
+  Eigen::EigenSolver<Eigen::MatrixXd> es(A);
+  if (es.info() != Eigen::Success) return poles;
+  for (Eigen::Index k = 0; k < A.rows(); ++k) {
+    const std::complex<double> mu = es.eigenvalues()[k];
+    if (mu.imag() <= 0 || std::abs(mu) == 0) continue;
+    RawPole rp;
+    rp.lambda = std::log(mu) / dt + decay;
+    rp.vec = output * es.eigenvectors().col(k);
+    poles.push_back(std::move(rp));
+  }
+  return poles;
+}
+
 double pole_hz(std::complex<double> l) { return std::abs(l) / (2 * kPi); }
 double pole_zeta(std::complex<double> l) { return -l.real() / std::abs(l); }
 double complex_mac(const Eigen::VectorXcd& a, const Eigen::VectorXcd& b) {
@@ -34,9 +51,11 @@ std::complex<double> pole_of(double f, double zeta) {
   return {-zeta * w, w * std::sqrt(std::max(0.0, 1 - zeta * zeta))};
 }
 
-std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<RawPole>>& orders, const std::vector<int>& order_of, double lo,
-                                               double hi, const IdentificationOptions& o, IdentificationSummary& s) {
-  // Step 1: the diagram, with hard flags (drawn) and continuous weights (used).
+namespace {
+// Step 1: the diagram (s.poles), with hard flags (drawn) and continuous weights (used); returns the poles with
+// weight, ascending in frequency.
+std::vector<Cand> weighted_poles(const std::vector<std::vector<RawPole>>& orders, const std::vector<int>& order_of, double lo, double hi,
+                                 const IdentificationOptions& o, IdentificationSummary& s) {
   std::vector<Cand> cand;
   for (std::size_t j = 0; j < orders.size(); ++j)
     for (std::size_t p = 0; p < orders[j].size(); ++p) {
@@ -73,8 +92,15 @@ std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<Raw
         cand.push_back({static_cast<int>(s.poles.size()), static_cast<int>(j), static_cast<int>(p), sp.frequency_hz, sp.weight});
       s.poles.push_back(sp);
     }
-  if (cand.empty()) return {};
   std::sort(cand.begin(), cand.end(), [](const Cand& a, const Cand& b) { return a.f < b.f || (a.f == b.f && a.pole < b.pole); });
+  return cand;
+}
+}  // namespace
+
+std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<RawPole>>& orders, const std::vector<int>& order_of, double lo,
+                                               double hi, const IdentificationOptions& o, IdentificationSummary& s) {
+  const std::vector<Cand> cand = weighted_poles(orders, order_of, lo, hi, o, s);
+  if (cand.empty()) return {};
   const double tol = o.cluster_tolerance;
   std::vector<double> fs(cand.size());
   for (std::size_t a = 0; a < cand.size(); ++a) fs[a] = cand[a].f;
@@ -157,20 +183,26 @@ std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<Raw
   return out;
 }
 
+namespace {
+// The indicator in dB at x, linearly interpolated between lines (clamped to the lines' range).
+double indicator_db(const Eigen::VectorXd& f, const Eigen::VectorXd& ind, double x) {
+  const Eigen::Index n = f.size();
+  const double df = (f[n - 1] - f[0]) / static_cast<double>(n - 1);
+  const double pos = std::clamp((x - f[0]) / df, 0.0, static_cast<double>(n - 1));
+  const Eigen::Index k = std::min<Eigen::Index>(static_cast<Eigen::Index>(pos), n - 2);
+  const double t = pos - static_cast<double>(k);
+  auto db = [&](Eigen::Index i) { return 10 * std::log10(std::max(ind[i], 1e-300)); };
+  return (1 - t) * db(k) + t * db(k + 1);
+}
+}  // namespace
+
 IndicatorEvidence indicator_evidence(const Eigen::VectorXd& f, const Eigen::VectorXd& ind, double fr, double zeta) {
   IndicatorEvidence e;
   const Eigen::Index n = f.size();
   if (n < 3 || ind.size() != n) return e;
   const double df = (f[n - 1] - f[0]) / static_cast<double>(n - 1);
   const double w = std::max(2 * zeta * fr, 2 * df);
-  // The indicator in dB, linearly interpolated between lines.
-  auto at = [&](double x) {
-    const double pos = std::clamp((x - f[0]) / df, 0.0, static_cast<double>(n - 1));
-    const Eigen::Index k = std::min<Eigen::Index>(static_cast<Eigen::Index>(pos), n - 2);
-    const double t = pos - static_cast<double>(k);
-    auto db = [&](Eigen::Index i) { return 10 * std::log10(std::max(ind[i], 1e-300)); };
-    return (1 - t) * db(k) + t * db(k + 1);
-  };
+  auto at = [&](double x) { return indicator_db(f, ind, x); };
   // The mode's level: the highest of its line neighbourhood (+- max(zeta f, df)).
   const double h = std::max(zeta * fr, df);
   double top = -1e300;
@@ -185,6 +217,26 @@ IndicatorEvidence indicator_evidence(const Eigen::VectorXd& f, const Eigen::Vect
   if (has_lo) e.edge_db = std::max(e.edge_db, top - at(fr - w) - own);
   if (has_hi) e.edge_db = std::max(e.edge_db, top - at(fr + w) - own);
   return e;
+}
+
+double indicator_dip_db(const Eigen::VectorXd& f, const Eigen::VectorXd& ind, double fa, double fb, double smooth_hz) {
+  const Eigen::Index n = f.size();
+  if (n < 3 || ind.size() != n) return 0;
+  if (fa > fb) std::swap(fa, fb);
+  // The indicator in dB averaged over the lines within smooth_hz of x (the interpolated value where none is).
+  auto level = [&](double x) {
+    const Eigen::Index a = std::lower_bound(f.data(), f.data() + n, x - smooth_hz) - f.data();
+    const Eigen::Index b = std::upper_bound(f.data(), f.data() + n, x + smooth_hz) - f.data();
+    if (b <= a) return indicator_db(f, ind, x);
+    double sum = 0;
+    for (Eigen::Index k = a; k < b; ++k) sum += 10 * std::log10(std::max(ind[k], 1e-300));
+    return sum / static_cast<double>(b - a);
+  };
+  const double top = std::min(level(fa), level(fb));
+  double low = top;
+  for (Eigen::Index k = 0; k < n; ++k)
+    if (f[k] > fa && f[k] < fb) low = std::min(low, level(f[k]));
+  return top - low;
 }
 
 namespace {
@@ -205,7 +257,8 @@ double joint_support(const std::vector<Candidate>& cands, const std::vector<std:
 }  // namespace
 
 std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& cands, const std::vector<IndicatorEvidence>& ev,
-                                                     const IdentificationOptions& o, std::size_t n_orders, IdentificationSummary& s) {
+                                                     const Eigen::VectorXd& indicator, const IdentificationOptions& o, std::size_t n_orders,
+                                                     IdentificationSummary& s) {
   auto reject = [&](const PoleCluster& c, Rejection r, double value, double limit, int into = -1) {
     RejectedCluster rc;
     rc.frequency_hz = c.frequency_hz;
@@ -235,7 +288,13 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
     for (std::size_t g = 0; g < groups.size() && into < 0; ++g) {
       const PoleCluster& h = cands[groups[g][0]].cluster;
       const double tol = std::max(o.merge_tolerance, std::max(c.damping_ratio, h.damping_ratio));
-      if (std::abs(c.frequency_hz - h.frequency_hz) > tol * h.frequency_hz) continue;
+      const double apart = std::abs(c.frequency_hz - h.frequency_hz);
+      // Within the half-power window, or beyond it on the flank of the stronger one's indicator peak; never with
+      // a dip of the indicator between them (two peaks: two modes, whose local shapes may look alike).
+      if (apart > o.merge_span * h.frequency_hz) continue;
+      if (apart > tol * h.frequency_hz && ev[groups[g][0]].peak_db < o.min_peak_db) continue;
+      const double smooth = 0.5 * std::min(c.damping_ratio * c.frequency_hz, h.damping_ratio * h.frequency_hz);
+      if (indicator_dip_db(s.frequency_hz, indicator, c.frequency_hz, h.frequency_hz, smooth) >= o.min_peak_db) continue;
       if (complex_mac(sk, head_shape[g]) >= o.merge_mac) into = static_cast<int>(g);
     }
     if (into < 0) {
@@ -299,6 +358,22 @@ void make_modes(const std::vector<Candidate>& cands, const std::vector<Indicator
     }
     s.modes.push_back(std::move(m));
   }
+}
+
+void select_modes(const OrderPoles& op, double lo, double hi, const IdentificationOptions& o, const Eigen::VectorXd& indicator, double decay,
+                  const std::function<Eigen::VectorXcd(const PoleCluster&)>& shape_of, IdentificationSummary& s) {
+  const std::vector<PoleCluster> clusters = stabilize_and_cluster(op.poles, op.order, lo, hi, o, s);
+  std::vector<Candidate> cands(clusters.size());
+  std::vector<IndicatorEvidence> peak(clusters.size());
+  for (std::size_t c = 0; c < clusters.size(); ++c) {
+    cands[c].cluster = clusters[c];
+    cands[c].strength = clusters[c].support;
+    const double zw = clusters[c].damping_ratio + decay / (2 * kPi * clusters[c].frequency_hz);
+    peak[c] = indicator_evidence(s.frequency_hz, indicator, clusters[c].frequency_hz, zw);
+    if (clusters[c].support < kShapedShare * o.min_cluster_fraction) continue;
+    cands[c].shape = shape_of(clusters[c]);
+  }
+  make_modes(cands, peak, check_evidence(cands, peak, indicator, o, op.poles.size(), s), op.poles.size(), s);
 }
 
 }  // namespace dynid::internal

@@ -134,4 +134,30 @@ ModalData sample_modes(const Model& model, const ModalResult& modes, const std::
   return d;
 }
 
+ModalData modes_subset(const ModalData& d, const std::vector<int>& keep) {
+  ModalData o = d;
+  const Eigen::Index n = static_cast<Eigen::Index>(keep.size()), had = d.frequencies_hz.size();
+  for (int k : keep)
+    if (k < 0 || k >= had) throw InputError("modal data: mode " + std::to_string(k + 1) + " asked for, " + std::to_string(had) + " given");
+  auto pick = [&](const Eigen::VectorXd& src, Eigen::VectorXd* dst) {
+    if (src.size() != had) return;
+    dst->resize(n);
+    for (Eigen::Index j = 0; j < n; ++j) (*dst)[j] = src[keep[static_cast<std::size_t>(j)]];
+  };
+  auto pick_columns = [&](const Eigen::MatrixXd& src, Eigen::MatrixXd* dst) {
+    if (src.cols() != had || src.size() == 0) return;
+    dst->resize(src.rows(), n);
+    for (Eigen::Index j = 0; j < n; ++j) dst->col(j) = src.col(keep[static_cast<std::size_t>(j)]);
+  };
+  pick(d.frequencies_hz, &o.frequencies_hz);
+  pick_columns(d.shapes, &o.shapes);
+  pick(d.damping_ratios, &o.damping_ratios);
+  pick(d.mpc, &o.mpc);
+  pick(d.frequency_std_hz, &o.frequency_std_hz);
+  pick(d.damping_std, &o.damping_std);
+  pick(d.shape_std, &o.shape_std);
+  pick_columns(d.shape_entry_std, &o.shape_entry_std);
+  return o;
+}
+
 }  // namespace dynid

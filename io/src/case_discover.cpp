@@ -190,8 +190,8 @@ namespace {
 using internal::format_number;
 
 ModalData keep_modes(ModalData m, const DiscoverSpec& d, std::vector<std::string>* notes) {
-  std::vector<Eigen::Index> keep;
-  for (Eigen::Index k = 0; k < m.frequencies_hz.size(); ++k) {
+  std::vector<int> keep;
+  for (int k = 0; k < m.num_modes(); ++k) {
     if (m.mpc.size() == m.frequencies_hz.size() && m.mpc[k] < d.min_mpc) {
       if (notes) notes->push_back("identified mode at " + std::to_string(m.frequencies_hz[k]) + " Hz left out: MPC " + std::to_string(m.mpc[k]) + " < " + std::to_string(d.min_mpc) + " (not a normal mode)");
       continue;
@@ -199,25 +199,7 @@ ModalData keep_modes(ModalData m, const DiscoverSpec& d, std::vector<std::string
     keep.push_back(k);
   }
   if (d.modes > 0 && static_cast<int>(keep.size()) > d.modes) keep.resize(static_cast<std::size_t>(d.modes));
-  ModalData o = m;
-  const Eigen::Index n = static_cast<Eigen::Index>(keep.size());
-  o.frequencies_hz.resize(n);
-  o.shapes.resize(m.shapes.rows(), n);
-  auto pick = [&](const Eigen::VectorXd& src, Eigen::VectorXd* dst) {
-    if (src.size() != m.frequencies_hz.size()) return;
-    dst->resize(n);
-    for (Eigen::Index j = 0; j < n; ++j) (*dst)[j] = src[keep[static_cast<std::size_t>(j)]];
-  };
-  for (Eigen::Index j = 0; j < n; ++j) {
-    o.frequencies_hz[j] = m.frequencies_hz[keep[static_cast<std::size_t>(j)]];
-    o.shapes.col(j) = m.shapes.col(keep[static_cast<std::size_t>(j)]);
-  }
-  pick(m.damping_ratios, &o.damping_ratios);
-  pick(m.mpc, &o.mpc);
-  pick(m.frequency_std_hz, &o.frequency_std_hz);
-  pick(m.damping_std, &o.damping_std);
-  pick(m.shape_std, &o.shape_std);
-  return o;
+  return modes_subset(m, keep);
 }
 }  // namespace
 

@@ -5,8 +5,12 @@
 #include <cmath>
 
 #include "dynid/io/point_map.hpp"
+#include "dynid/mesh/error.hpp"
+#include "internal/text_util.hpp"
 
 namespace dynid {
+
+using internal::format_number;
 
 namespace {
 std::vector<double> vec(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
@@ -72,6 +76,19 @@ UpdateRun update_case(const Case& c, const ModalData* measured) {
   run.measured = measured ? first_modes(*measured, u.modes) : update_measured_data(c);
   run.pm = std::make_unique<ParametricModel>(c.model);
   for (const Parameter& p : u.parameters) run.pm->add(p);
+  // Measured modes without a plausible partner at the initial values are set aside, never forced onto a model
+  // mode (the pairing of detect and discover: MAC >= min_mac with a mode the sensors see, within a factor 2).
+  const PlausibleModes pl = plausible_modes(*run.pm, run.measured, u.initial, u.options);
+  if (pl.paired.empty())
+    throw InputError("update: no measured mode pairs with a model mode the sensors see (MAC >= " + format_number(u.options.min_mac, 3) +
+                     ", within a factor " + format_number(kMaxPairingRatio, 2) + " in frequency); check the DOF labels and directions");
+  std::vector<std::string> aside;
+  for (int k : pl.unpaired)
+    aside.push_back("measured mode " + std::to_string(k + 1) + " (" + format_number(run.measured.frequencies_hz[k], 5) +
+                    " Hz) has no plausible partner in the model at the initial values (the best remaining is " +
+                    format_number(pl.correlation.model_hz[k], 5) + " Hz at MAC " + format_number(pl.correlation.mac[k], 3) +
+                    "): set aside, not fitted");
+  if (!pl.unpaired.empty()) run.measured = modes_subset(run.measured, pl.paired);
   const MeasuredNoise noise = measured_noise(run.measured, u.options);
   if (u.multistart) {
     run.search = fit_multistart(*run.pm, run.measured, u.initial, u.free, noise.options, u.search);
@@ -81,6 +98,7 @@ UpdateRun update_case(const Case& c, const ModalData* measured) {
     run.fit = fit_parameters(*run.pm, run.measured, u.initial, u.free, noise.options);
   }
   run.fit.warnings.insert(run.fit.warnings.begin(), noise.warnings.begin(), noise.warnings.end());
+  run.fit.warnings.insert(run.fit.warnings.begin(), aside.begin(), aside.end());
   return run;
 }
 

@@ -16,6 +16,18 @@ struct RawPole {
   Eigen::VectorXcd vec;
 };
 
+/// The poles of every model order, as the stabilization diagram takes them.
+struct OrderPoles {
+  std::vector<std::vector<RawPole>> poles;  ///< per order, its poles
+  std::vector<int> order;                   ///< the model order of each
+};
+
+/// Pole extraction (LSCF and SSI alike): the eigenvalues mu of a discrete-time state (or companion) matrix A
+/// with Im mu > 0 become continuous-time poles ln(mu) / dt + decay (rad/s; `decay` takes off an exponential
+/// window's damping), each with the vector `output` * (its eigenvector) (LSCF: the participation rows; SSI: C).
+/// Empty when the eigen-solve fails.
+std::vector<RawPole> discrete_poles(const Eigen::MatrixXd& A, double dt, double decay, const Eigen::MatrixXd& output);
+
 double pole_hz(std::complex<double> l);
 double pole_zeta(std::complex<double> l);
 double complex_mac(const Eigen::VectorXcd& a, const Eigen::VectorXcd& b);
@@ -47,6 +59,10 @@ struct IndicatorEvidence {
   double peak_db = 0, edge_db = 0;
 };
 IndicatorEvidence indicator_evidence(const Eigen::VectorXd& frequency_hz, const Eigen::VectorXd& indicator, double f, double zeta);
+/// How far (dB) the indicator falls between fa and fb below the lower of its levels at fa and fb (0 when it never
+/// falls below them, or no line lies between): two peaks, or the flank of one. Levels are the dB values averaged
+/// over +- smooth_hz (half a half-power half-bandwidth: finer lines of short averages scatter by dB).
+double indicator_dip_db(const Eigen::VectorXd& frequency_hz, const Eigen::VectorXd& indicator, double fa, double fb, double smooth_hz);
 
 /// A cluster with its shape, for the evidence checks.
 struct Candidate {
@@ -56,18 +72,27 @@ struct Candidate {
 };
 
 /// Step 3: the checks, on candidates with shapes (those without one, below the shaping limit, are rejected for
-/// their support). Splits are merged first (a weaker cluster within the merge window with the same shape joins
-/// the stronger), then each group is checked: joint support, MPC and mode indicator of its strongest cluster.
+/// their support). Splits are merged first (a weaker cluster with the same shape joins the stronger when within
+/// the merge window, or within merge_span with no indicator dip of min_peak_db between them), then each group is
+/// checked: joint support, MPC and mode indicator of its strongest cluster.
 /// Returns the accepted modes, ascending in frequency, each as its strongest candidate followed by the splits
 /// merged into it; appends every rejected candidate to s.rejected. `evidence` gives each candidate's
 /// indicator_evidence; `n_orders` the number of model orders.
 std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& candidates, const std::vector<IndicatorEvidence>& evidence,
+                                                     const Eigen::VectorXd& indicator,
                                                      const IdentificationOptions& o, std::size_t n_orders, IdentificationSummary& s);
 
 /// The accepted modes as IdentifiedModes (frequency, damping, spreads and shape of the strongest cluster, the
 /// joint support of all), and the diagram's poles marked with their mode.
 void make_modes(const std::vector<Candidate>& candidates, const std::vector<IndicatorEvidence>& evidence, const std::vector<std::vector<std::size_t>>& accepted,
                 std::size_t n_orders, IdentificationSummary& s);
+
+/// Steps 1-3 on the poles of every order: the diagram and clusters in [lo, hi], each cluster's indicator
+/// evidence on `indicator` (a power-like mode indicator on s.frequency_hz; the cluster's damping widened by an
+/// exponential window's `decay`), a shape from `shape_of` for the clusters with enough support to be checked,
+/// the checks, and s.modes (shapes as given, before any final re-estimation).
+void select_modes(const OrderPoles& poles, double lo, double hi, const IdentificationOptions& o, const Eigen::VectorXd& indicator, double decay,
+                  const std::function<Eigen::VectorXcd(const PoleCluster&)>& shape_of, IdentificationSummary& s);
 
 /// Clusters with at least this share of min_cluster_fraction get a shape and the evidence checks (weaker ones
 /// are rejected for their support without one).

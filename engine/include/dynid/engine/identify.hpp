@@ -22,8 +22,11 @@
 //        a spectral edge: the indicator falls from f to f -+ w more than max_edge_db further than the pole's own
 //          resonance can (10 log10(1 + (w / zeta f)^2)): the spectrum stops there (the excitation's band, an
 //          anti-alias filter) and the pole models the edge, not a resonance;
-//        a split: within max(merge_tolerance, zeta) in frequency of a stronger cluster (one half-power
-//          half-bandwidth) with a shape MAC >= merge_mac: one physical mode whose poles drifted over orders. Splits
+//        a split: a shape MAC >= merge_mac with a stronger cluster within max(merge_tolerance, zeta) in
+//          frequency (one half-power half-bandwidth), or within merge_span on the flank of the stronger one's
+//          indicator peak (it has one), and one peak of the indicator between them (nowhere min_peak_db below
+//          the lower of their levels; a dip means two modes, whose local shapes may look alike): one physical
+//          mode whose poles drifted over orders, or a second report of it. Splits
 //          are merged before the other checks: the group's support counts, per order, its best pole; its
 //          frequency, damping and shape are the strongest cluster's.
 // Uncertainty: the spread over orders understates the scatter of a mode from one data set to the next. With
@@ -68,6 +71,7 @@ struct IdentificationOptions {
   double max_edge_db = 10;          ///< how much steeper than its resonance the indicator may fall beside it
   double merge_tolerance = 0.03;    ///< clusters this close (relative, or zeta if wider) ...
   double merge_mac = 0.9;           ///< ... with shapes this alike are one mode
+  double merge_span = 0.15;         ///< so are those this close on the flank of the stronger's peak
   // SSI-cov.
   int block_rows = 0;  ///< i (0 = automatic from the band's lowest frequency and the maximum order)
   int decimate = 0;    ///< 0 = automatic (to about 2.5x the band's top), 1 = none
@@ -163,7 +167,9 @@ struct IdentificationSummary {
 /// hits' spectral roll-off show their peaks too).
 ///   band: [0.5 x lowest peak, min(1.25 x highest peak, 0.45 x sampling rate)], over the peaks that stand
 ///         >= 10 dB above their surroundings (prominence) and >= 10 dB above the spectrum's 10th-percentile
-///         level (the noise floor); the whole range below 0.45 fs when there is none.
+///         level (the noise floor); the whole range below 0.45 fs when there is none. Continuous records with a
+///         measured force: the top reaches where the force's spectrum ends (the highest line within 10 dB of its
+///         median level), when the peaks' rule stops below it (the highest modes' peaks stand out less).
 ///   resolution (continuous records): the lowest peak's half-power bandwidth 2 zeta f (zeta from the -3 dB
 ///         width, refined with longer segments while the width spans fewer than 4 lines) spans 4 lines:
 ///         segment = fs / (zeta f / 2), a power of two, at most a quarter of the shortest record (>= 7

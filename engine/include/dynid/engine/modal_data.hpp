@@ -57,6 +57,10 @@ std::vector<MeasuredDof> all_dofs(const Model& model);
 /// The free DOFs of the given types (e.g. translations) at every node (or at `nodes` if not empty).
 std::vector<MeasuredDof> dofs_of_types(const Model& model, DofMask types, const std::vector<int>& nodes = {});
 
+/// The modes `keep` (0-based, in that order) of modal data, every per-mode field (damping, MPC, standard
+/// deviations, entry standard deviations) cut alike.
+ModalData modes_subset(const ModalData& d, const std::vector<int>& keep);
+
 /// A model's modes sampled at DOFs, as a test would see them: `first` is the first mode taken (0-based, e.g. 2
 /// to skip two rigid-body modes), `count` modes. Shapes are the mass-normalised mode shapes at those DOFs.
 ModalData sample_modes(const Model& model, const ModalResult& modes, const std::vector<MeasuredDof>& dofs,

@@ -153,4 +153,17 @@ struct Correlation {
 Correlation correlate(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta,
                       const FitOptions& options);
 
+/// The measured modes a fit should use: those with a plausible partner in the model at theta (correlate(): MAC >=
+/// min_mac with a model mode the sensors see, within max_frequency_ratio and never beyond kMaxPairingRatio), and
+/// the others (a spurious mode, or one the model does not have), which are left out rather than forced onto another
+/// model mode, where one bad mode could carry the fit. Updating applies it at the initial values, as discovery does
+/// at the model as given.
+struct PlausibleModes {
+  std::vector<int> paired;   ///< measured modes (0-based) with a plausible partner, ascending
+  std::vector<int> unpaired; ///< the others, ascending
+  Correlation correlation;   ///< every measured mode at theta (model_hz and mac of an unpaired one: the forced partner's)
+};
+PlausibleModes plausible_modes(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta,
+                               const FitOptions& options);
+
 }  // namespace dynid
