@@ -197,7 +197,8 @@ TEST(DetectPairing, ModeTheSensorsCannotSeeIsNoPartner) {
     const double v = sensor_visibility(r.modes.col(j), rows, translations);
     double trace = 0;
     for (int e : rows) trace += r.modes(e, j) * r.modes(e, j);
-    if (!r.rigid_body[j] && v > 0 && v < kMinPairingVisibility && std::sqrt(trace) > 1e-6 * r.modes.col(j).norm()) hidden = static_cast<int>(j);
+    if (!r.rigid_body[j] && v > 0 && v < kMinPairingVisibility && std::sqrt(trace) > 1e-6 * r.modes.col(j).norm())
+      hidden = static_cast<int>(j);
   }
   ASSERT_GE(hidden, 3) << "the frame has no mode its horizontal sensors barely see";
   ModalData d = sample_modes(c.model, r, sensors, 0, 3, "sway modes");
@@ -208,7 +209,9 @@ TEST(DetectPairing, ModeTheSensorsCannotSeeIsNoPartner) {
   d.shapes.col(3) = h.shapes.col(0);
   const DetectSummary s = detect(c.model, d, DetectOptions{});
   bool unpaired = false;
-  for (const std::string& w : s.warnings) unpaired = unpaired || w.find("mode 4 (") != std::string::npos && w.find("pairs with no model mode") != std::string::npos;
+  for (const std::string& w : s.warnings)
+    unpaired =
+        unpaired || w.find("mode 4 (") != std::string::npos && w.find("pairs with no model mode") != std::string::npos;
   EXPECT_TRUE(unpaired);
   EXPECT_EQ(s.used_modes, (std::vector<int>{0, 1, 2}));
 }

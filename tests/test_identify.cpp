@@ -9,9 +9,9 @@
 #include "dynid/engine/frf.hpp"
 #include "dynid/engine/identify.hpp"
 #include "dynid/engine/virtual_test.hpp"
-#include "dynid/mesh/generators.hpp"
 #include "dynid/io/case_file.hpp"
 #include "dynid/io/test_data.hpp"
+#include "dynid/mesh/generators.hpp"
 #include "internal/identify_select.hpp"
 #include "test_util.hpp"
 
@@ -163,8 +163,11 @@ struct SplitPair {
   explicit SplitPair(bool second_resonance, double apart = 0.04, double zeta = 0.01) {
     f = Eigen::VectorXd::LinSpaced(801, 0.8, 1.2);
     power.resize(f.size());
-    auto resonance = [&](double x, double fr) { return 1 / (std::pow(1 - x * x / (fr * fr), 2) + std::pow(2 * zeta * x / fr, 2)); };
-    for (Eigen::Index k = 0; k < f.size(); ++k) power[k] = resonance(f[k], 1.0) + (second_resonance ? resonance(f[k], 1 + apart) : 0.0);
+    auto resonance = [&](double x, double fr) {
+      return 1 / (std::pow(1 - x * x / (fr * fr), 2) + std::pow(2 * zeta * x / fr, 2));
+    };
+    for (Eigen::Index k = 0; k < f.size(); ++k)
+      power[k] = resonance(f[k], 1.0) + (second_resonance ? resonance(f[k], 1 + apart) : 0.0);
     s.frequency_hz = f;
     Eigen::VectorXcd shape(5);
     shape << 1, 0.8, -0.3, 0.5, -1;
@@ -181,7 +184,9 @@ struct SplitPair {
       ev.push_back(internal::indicator_evidence(f, power, fr, zeta));
     }
   }
-  std::vector<std::vector<std::size_t>> check() { return internal::check_evidence(cands, ev, power, IdentificationOptions{}, 10, s); }
+  std::vector<std::vector<std::size_t>> check() {
+    return internal::check_evidence(cands, ev, power, IdentificationOptions{}, 10, s);
+  }
 };
 
 TEST(Selection, SecondReportOfAModeOnItsFlankIsMerged) {

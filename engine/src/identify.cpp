@@ -147,7 +147,8 @@ bool IdentificationOptions::IsValid(std::string* why) const {
   if (block_rows < 0 || decimate < 0) return fail("block rows and decimation must be >= 0");
   if (!(min_mpc >= 0 && min_mpc <= 1)) return fail("the MPC limit must be in [0, 1]");
   if (!std::isfinite(min_peak_db) || !(max_edge_db > 0)) return fail("the indicator peak limit must be finite and the edge limit > 0 dB");
-  if (!(merge_tolerance >= 0 && merge_tolerance < 0.5) || !(merge_span >= 0 && merge_span < 0.5) || !(merge_mac > 0 && merge_mac <= 1))
+  if (!(merge_tolerance >= 0 && merge_tolerance < 0.5) || !(merge_span >= 0 && merge_span < 0.5) ||
+      !(merge_mac > 0 && merge_mac <= 1))
     return fail("the merge tolerance and span must be in [0, 0.5) and the merge MAC in (0, 1]");
   if (segment < -1 || (segment > 0 && segment < 8)) return fail("the segment must be -1 (automatic), 0 (whole records) or >= 8 samples");
   if (!(exponential_end >= 0 && exponential_end < 1)) return fail("the exponential window end must be in [0, 1)");
@@ -246,8 +247,8 @@ namespace {
 // receptance, poles do not depend on the quantity), and the model orders.
 struct LscfInput {
   FrfData frf;
-  Eigen::VectorXd w;   // rad/s of the lines in the band
-  Eigen::MatrixXcd H;  // FRFs at those lines
+  Eigen::VectorXd w;               // rad/s of the lines in the band
+  Eigen::MatrixXcd H;              // FRFs at those lines
   double lo = 0, hi = 0, top = 0;  // band; frequency of the highest line in it
   int ni = 0, no = 0, pmin = 0, pmax = 0, step = 1;
 };
@@ -274,7 +275,8 @@ LscfInput lscf_input(const FrfData& frf_in, const IdentificationOptions& o) {
   if (o.max_order == 0) in.pmax = std::min(in.pmax, static_cast<int>(nf / 2) - 1);
   in.step = o.order_step > 0 ? o.order_step : 1;
   if (nf < 2 * (in.pmax + 1) || in.pmax < std::max(in.pmin + 2, 6))
-    throw InputError("LSCF: " + std::to_string(nf) + " frequency lines in the band are too few for order " + std::to_string(std::max(in.pmax, 6)) +
+    throw InputError("LSCF: " + std::to_string(nf) + " frequency lines in the band are too few for order " +
+                     std::to_string(std::max(in.pmax, 6)) +
                      ": widen the band or use longer records (finer frequency lines)");
   in.w.resize(nf);
   in.H.resize(nf, frf.H.cols());
@@ -389,10 +391,12 @@ Eigen::VectorXcd principal(const Eigen::MatrixXcd& Rr) {
 }
 
 // A cluster's shape for the evidence checks: the principal vector of its residues from the lines around it.
-Eigen::VectorXcd lscf_cluster_shape(const LscfInput& in, const internal::PoleCluster& c, double window_decay, double resolution_hz) {
+Eigen::VectorXcd lscf_cluster_shape(const LscfInput& in, const internal::PoleCluster& c, double window_decay,
+                                    double resolution_hz) {
   const double zw = c.damping_ratio + window_decay / (2 * kPi * c.frequency_hz);
   const std::complex<double> pw = internal::pole_of(c.frequency_hz, c.damping_ratio) - window_decay;
-  const Eigen::VectorXcd R = local_residues(in.w, in.H, pw, std::max(3 * zw * std::abs(pw), 5 * 2 * kPi * resolution_hz));
+  const Eigen::VectorXcd R =
+      local_residues(in.w, in.H, pw, std::max(3 * zw * std::abs(pw), 5 * 2 * kPi * resolution_hz));
   return principal(outputs_by_inputs(R.transpose(), in.no, in.ni));
 }
 
@@ -400,7 +404,8 @@ Eigen::VectorXcd lscf_cluster_shape(const LscfInput& in, const internal::PoleClu
 void lscf_mode_shapes(const LscfInput& in, double window_decay, IdentificationSummary& s) {
   if (s.modes.empty()) return;
   std::vector<std::complex<double>> poles;
-  for (const IdentifiedMode& m : s.modes) poles.push_back(internal::pole_of(m.frequency_hz, m.damping_ratio) - window_decay);
+  for (const IdentifiedMode& m : s.modes)
+    poles.push_back(internal::pole_of(m.frequency_hz, m.damping_ratio) - window_decay);
   const Eigen::MatrixXcd res = lsfd(in.w, in.H, poles);
   double top = 0;
   for (std::size_t r = 0; r < s.modes.size(); ++r) {
@@ -419,7 +424,7 @@ void lscf_mode_shapes(const LscfInput& in, double window_decay, IdentificationSu
 struct SsiSetup {
   std::vector<int> outs;
   int l = 0, dec = 1, nmin = 2, nmax = 80, step = 2, i = 0;  // outputs, decimation, orders, block rows
-  double fs = 0, lo = 0, hi = 0, flow = 0;                  // decimated rate, band, lowest frequency of interest
+  double fs = 0, lo = 0, hi = 0, flow = 0;                   // decimated rate, band, lowest frequency of interest
 };
 
 SsiSetup ssi_setup(const Recording& rec, const IdentificationOptions& o) {
@@ -429,7 +434,8 @@ SsiSetup ssi_setup(const Recording& rec, const IdentificationOptions& o) {
   if (u.l < 1) throw InputError("SSI: " + rec.source + " has no output channels");
   const double fs0 = rec.sample_rate_hz;
   u.hi = o.band_hi_hz > 0 ? o.band_hi_hz : 0.4 * fs0;
-  if (u.hi > fs0 / 2) throw InputError("SSI: the band's top is above the Nyquist frequency " + std::to_string(fs0 / 2) + " Hz");
+  if (u.hi > fs0 / 2)
+    throw InputError("SSI: the band's top is above the Nyquist frequency " + std::to_string(fs0 / 2) + " Hz");
   u.dec = o.decimate > 0 ? o.decimate : std::max(1, static_cast<int>(std::floor(fs0 / (2.5 * u.hi))));
   u.fs = fs0 / u.dec;
   u.lo = o.band_lo_hz;
@@ -438,10 +444,12 @@ SsiSetup ssi_setup(const Recording& rec, const IdentificationOptions& o) {
   u.step = o.order_step > 0 ? o.order_step : 2;
   u.flow = u.lo > 0 ? u.lo : u.fs / 100;
   const int l = u.l;
-  u.i = o.block_rows > 0 ? o.block_rows : std::max((u.nmax + l - 1) / l + 2, static_cast<int>(std::ceil(u.fs / u.flow)));
+  u.i =
+      o.block_rows > 0 ? o.block_rows : std::max((u.nmax + l - 1) / l + 2, static_cast<int>(std::ceil(u.fs / u.flow)));
   u.i = std::min(u.i, std::max((u.nmax + l - 1) / l + 2, 1500 / l));
   if ((u.i - 1) * l < u.nmax)
-    throw InputError("SSI: (block rows - 1) x outputs (" + std::to_string((u.i - 1) * l) + ") must reach the maximum order " + std::to_string(u.nmax) +
+    throw InputError("SSI: (block rows - 1) x outputs (" + std::to_string((u.i - 1) * l) +
+                     ") must reach the maximum order " + std::to_string(u.nmax) +
                      "; raise the block rows or lower the order");
   return u;
 }
@@ -454,8 +462,8 @@ std::vector<Eigen::MatrixXd> ssi_records(const Recording& rec, const SsiSetup& u
     for (int c = 0; c < u.l; ++c) y.col(c) = x.col(u.outs[c]).array() - x.col(u.outs[c]).mean();
     y = decimate(y, u.dec);
     if (y.rows() <= 4 * u.i)
-      throw InputError("SSI: a record of " + rec.source + " has too few samples (" + std::to_string(y.rows()) + " after decimation) for " +
-                       std::to_string(u.i) + " block rows");
+      throw InputError("SSI: a record of " + rec.source + " has too few samples (" + std::to_string(y.rows()) +
+                       " after decimation) for " + std::to_string(u.i) + " block rows");
     out.push_back(std::move(y));
   }
   return out;
@@ -505,10 +513,13 @@ internal::OrderPoles ssi_poles(const Eigen::MatrixXd& Tm, const SsiSetup& u) {
 
 // Background and mode indicator: the first singular value of the output cross-spectral matrix (Welch, the
 // plan's resolution when given, else segments of 8 periods of the lowest frequency of interest).
-void output_spectrum_indicator(const std::vector<Eigen::MatrixXd>& records, const SsiSetup& u, const IdentificationOptions& o, IdentificationSummary& s) {
+void output_spectrum_indicator(const std::vector<Eigen::MatrixXd>& records, const SsiSetup& u,
+                               const IdentificationOptions& o, IdentificationSummary& s) {
   WelchOptions wo;
   int seg = 8;
-  const Eigen::Index shortest = std::min_element(records.begin(), records.end(), [](const auto& a, const auto& b) { return a.rows() < b.rows(); })->rows();
+  const Eigen::Index shortest = std::min_element(records.begin(), records.end(), [](const auto& a, const auto& b) {
+                                  return a.rows() < b.rows();
+                                })->rows();
   if (o.segment > 0) {  // the plan's resolution, in decimated samples
     while (seg * 2 <= shortest && seg * 2 <= o.segment / u.dec) seg *= 2;
   } else {
@@ -526,7 +537,8 @@ void output_spectrum_indicator(const std::vector<Eigen::MatrixXd>& records, cons
 
 // A cluster's shape: the weighted mean of its poles' shapes, each turned to the strongest member's phase.
 Eigen::VectorXcd ssi_cluster_shape(const internal::OrderPoles& op, const internal::PoleCluster& pc) {
-  const std::size_t top = static_cast<std::size_t>(std::max_element(pc.member_weight.begin(), pc.member_weight.end()) - pc.member_weight.begin());
+  const std::size_t top = static_cast<std::size_t>(std::max_element(pc.member_weight.begin(), pc.member_weight.end()) -
+                                                   pc.member_weight.begin());
   const Eigen::VectorXcd ref = op.poles[pc.members[top].first][pc.members[top].second].vec.normalized();
   Eigen::VectorXcd sum = Eigen::VectorXcd::Zero(ref.size());
   for (std::size_t m = 0; m < pc.members.size(); ++m) {
@@ -563,8 +575,9 @@ IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationO
   const internal::OrderPoles poles = lscf_poles(in, lscf_normal_equations(in), decay);
   // Selection on the CMIF's power (the windowed data's peaks are wider by the window's decay), then LSFD at the
   // selected poles for the shapes.
-  internal::select_modes(poles, in.lo, in.hi, o, s.background.cwiseAbs2(), decay,
-                         [&](const internal::PoleCluster& c) { return lscf_cluster_shape(in, c, decay, s.resolution_hz); }, s);
+  internal::select_modes(
+      poles, in.lo, in.hi, o, s.background.cwiseAbs2(), decay,
+      [&](const internal::PoleCluster& c) { return lscf_cluster_shape(in, c, decay, s.resolution_hz); }, s);
   lscf_mode_shapes(in, decay, s);
   s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return s;
@@ -586,7 +599,9 @@ IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOpt
   const std::vector<Eigen::MatrixXd> records = ssi_records(rec, u);
   const internal::OrderPoles poles = ssi_poles(ssi_toeplitz(records, u), u);
   output_spectrum_indicator(records, u, o, s);
-  internal::select_modes(poles, u.lo, u.hi, o, s.background, 0.0, [&](const internal::PoleCluster& c) { return ssi_cluster_shape(poles, c); }, s);
+  internal::select_modes(
+      poles, u.lo, u.hi, o, s.background, 0.0,
+      [&](const internal::PoleCluster& c) { return ssi_cluster_shape(poles, c); }, s);
   for (IdentifiedMode& m : s.modes) finish_shape(m);
   mark_twins(s.modes, false);
   s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();

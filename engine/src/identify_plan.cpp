@@ -210,7 +210,8 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
       if (edge > p.band_hi_hz) {
         p.band_hi_hz = edge;
         char b[160];
-        std::snprintf(b, sizeof b, "band top %.4g Hz: where the measured force's spectrum ends (10 dB below its median)", edge);
+        std::snprintf(b, sizeof b,
+                      "band top %.4g Hz: where the measured force's spectrum ends (10 dB below its median)", edge);
         p.notes.push_back(b);
       }
     }

@@ -2,11 +2,10 @@
 // dynid/engine/identify.hpp, header comment, steps 1-3).
 #include "internal/identify_select.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <map>
-
-#include <Eigen/Eigenvalues>
 
 namespace dynid::internal {
 
@@ -54,8 +53,8 @@ std::complex<double> pole_of(double f, double zeta) {
 namespace {
 // Step 1: the diagram (s.poles), with hard flags (drawn) and continuous weights (used); returns the poles with
 // weight, ascending in frequency.
-std::vector<Cand> weighted_poles(const std::vector<std::vector<RawPole>>& orders, const std::vector<int>& order_of, double lo, double hi,
-                                 const IdentificationOptions& o, IdentificationSummary& s) {
+std::vector<Cand> weighted_poles(const std::vector<std::vector<RawPole>>& orders, const std::vector<int>& order_of,
+                                 double lo, double hi, const IdentificationOptions& o, IdentificationSummary& s) {
   std::vector<Cand> cand;
   for (std::size_t j = 0; j < orders.size(); ++j)
     for (std::size_t p = 0; p < orders[j].size(); ++p) {
@@ -97,8 +96,9 @@ std::vector<Cand> weighted_poles(const std::vector<std::vector<RawPole>>& orders
 }
 }  // namespace
 
-std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<RawPole>>& orders, const std::vector<int>& order_of, double lo,
-                                               double hi, const IdentificationOptions& o, IdentificationSummary& s) {
+std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<RawPole>>& orders,
+                                               const std::vector<int>& order_of, double lo, double hi,
+                                               const IdentificationOptions& o, IdentificationSummary& s) {
   const std::vector<Cand> cand = weighted_poles(orders, order_of, lo, hi, o, s);
   if (cand.empty()) return {};
   const double tol = o.cluster_tolerance;
@@ -256,9 +256,10 @@ double joint_support(const std::vector<Candidate>& cands, const std::vector<std:
 }
 }  // namespace
 
-std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& cands, const std::vector<IndicatorEvidence>& ev,
-                                                     const Eigen::VectorXd& indicator, const IdentificationOptions& o, std::size_t n_orders,
-                                                     IdentificationSummary& s) {
+std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& cands,
+                                                     const std::vector<IndicatorEvidence>& ev,
+                                                     const Eigen::VectorXd& indicator, const IdentificationOptions& o,
+                                                     std::size_t n_orders, IdentificationSummary& s) {
   auto reject = [&](const PoleCluster& c, Rejection r, double value, double limit, int into = -1) {
     RejectedCluster rc;
     rc.frequency_hz = c.frequency_hz;
@@ -294,7 +295,8 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
       if (apart > o.merge_span * h.frequency_hz) continue;
       if (apart > tol * h.frequency_hz && ev[groups[g][0]].peak_db < o.min_peak_db) continue;
       const double smooth = 0.5 * std::min(c.damping_ratio * c.frequency_hz, h.damping_ratio * h.frequency_hz);
-      if (indicator_dip_db(s.frequency_hz, indicator, c.frequency_hz, h.frequency_hz, smooth) >= o.min_peak_db) continue;
+      if (indicator_dip_db(s.frequency_hz, indicator, c.frequency_hz, h.frequency_hz, smooth) >= o.min_peak_db)
+        continue;
       if (complex_mac(sk, head_shape[g]) >= o.merge_mac) into = static_cast<int>(g);
     }
     if (into < 0) {
@@ -360,7 +362,8 @@ void make_modes(const std::vector<Candidate>& cands, const std::vector<Indicator
   }
 }
 
-void select_modes(const OrderPoles& op, double lo, double hi, const IdentificationOptions& o, const Eigen::VectorXd& indicator, double decay,
+void select_modes(const OrderPoles& op, double lo, double hi, const IdentificationOptions& o,
+                  const Eigen::VectorXd& indicator, double decay,
                   const std::function<Eigen::VectorXcd(const PoleCluster&)>& shape_of, IdentificationSummary& s) {
   const std::vector<PoleCluster> clusters = stabilize_and_cluster(op.poles, op.order, lo, hi, o, s);
   std::vector<Candidate> cands(clusters.size());

@@ -138,7 +138,8 @@ ModalData modes_subset(const ModalData& d, const std::vector<int>& keep) {
   ModalData o = d;
   const Eigen::Index n = static_cast<Eigen::Index>(keep.size()), had = d.frequencies_hz.size();
   for (int k : keep)
-    if (k < 0 || k >= had) throw InputError("modal data: mode " + std::to_string(k + 1) + " asked for, " + std::to_string(had) + " given");
+    if (k < 0 || k >= had)
+      throw InputError("modal data: mode " + std::to_string(k + 1) + " asked for, " + std::to_string(had) + " given");
   auto pick = [&](const Eigen::VectorXd& src, Eigen::VectorXd* dst) {
     if (src.size() != had) return;
     dst->resize(n);

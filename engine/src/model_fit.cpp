@@ -831,10 +831,12 @@ Correlation correlate(const ParametricModel& pm, const ModalData& measured, cons
   return c;
 }
 
-PlausibleModes plausible_modes(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta, const FitOptions& options) {
+PlausibleModes plausible_modes(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta,
+                               const FitOptions& options) {
   PlausibleModes out;
   out.correlation = correlate(pm, measured, theta, options);
-  for (int k = 0; k < measured.num_modes(); ++k) (out.correlation.model_mode[static_cast<std::size_t>(k)] >= 0 ? out.paired : out.unpaired).push_back(k);
+  for (int k = 0; k < measured.num_modes(); ++k)
+    (out.correlation.model_mode[static_cast<std::size_t>(k)] >= 0 ? out.paired : out.unpaired).push_back(k);
   return out;
 }
 

@@ -80,14 +80,15 @@ UpdateRun update_case(const Case& c, const ModalData* measured) {
   // mode (the pairing of detect and discover: MAC >= min_mac with a mode the sensors see, within a factor 2).
   const PlausibleModes pl = plausible_modes(*run.pm, run.measured, u.initial, u.options);
   if (pl.paired.empty())
-    throw InputError("update: no measured mode pairs with a model mode the sensors see (MAC >= " + format_number(u.options.min_mac, 3) +
-                     ", within a factor " + format_number(kMaxPairingRatio, 2) + " in frequency); check the DOF labels and directions");
+    throw InputError("update: no measured mode pairs with a model mode the sensors see (MAC >= " +
+                     format_number(u.options.min_mac, 3) + ", within a factor " + format_number(kMaxPairingRatio, 2) +
+                     " in frequency); check the DOF labels and directions");
   std::vector<std::string> aside;
   for (int k : pl.unpaired)
     aside.push_back("measured mode " + std::to_string(k + 1) + " (" + format_number(run.measured.frequencies_hz[k], 5) +
                     " Hz) has no plausible partner in the model at the initial values (the best remaining is " +
-                    format_number(pl.correlation.model_hz[k], 5) + " Hz at MAC " + format_number(pl.correlation.mac[k], 3) +
-                    "): set aside, not fitted");
+                    format_number(pl.correlation.model_hz[k], 5) + " Hz at MAC " +
+                    format_number(pl.correlation.mac[k], 3) + "): set aside, not fitted");
   if (!pl.unpaired.empty()) run.measured = modes_subset(run.measured, pl.paired);
   const MeasuredNoise noise = measured_noise(run.measured, u.options);
   if (u.multistart) {

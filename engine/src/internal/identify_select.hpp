@@ -62,7 +62,8 @@ IndicatorEvidence indicator_evidence(const Eigen::VectorXd& frequency_hz, const 
 /// How far (dB) the indicator falls between fa and fb below the lower of its levels at fa and fb (0 when it never
 /// falls below them, or no line lies between): two peaks, or the flank of one. Levels are the dB values averaged
 /// over +- smooth_hz (half a half-power half-bandwidth: finer lines of short averages scatter by dB).
-double indicator_dip_db(const Eigen::VectorXd& frequency_hz, const Eigen::VectorXd& indicator, double fa, double fb, double smooth_hz);
+double indicator_dip_db(const Eigen::VectorXd& frequency_hz, const Eigen::VectorXd& indicator, double fa, double fb,
+                        double smooth_hz);
 
 /// A cluster with its shape, for the evidence checks.
 struct Candidate {
@@ -78,9 +79,10 @@ struct Candidate {
 /// Returns the accepted modes, ascending in frequency, each as its strongest candidate followed by the splits
 /// merged into it; appends every rejected candidate to s.rejected. `evidence` gives each candidate's
 /// indicator_evidence; `n_orders` the number of model orders.
-std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& candidates, const std::vector<IndicatorEvidence>& evidence,
-                                                     const Eigen::VectorXd& indicator,
-                                                     const IdentificationOptions& o, std::size_t n_orders, IdentificationSummary& s);
+std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& candidates,
+                                                     const std::vector<IndicatorEvidence>& evidence,
+                                                     const Eigen::VectorXd& indicator, const IdentificationOptions& o,
+                                                     std::size_t n_orders, IdentificationSummary& s);
 
 /// The accepted modes as IdentifiedModes (frequency, damping, spreads and shape of the strongest cluster, the
 /// joint support of all), and the diagram's poles marked with their mode.
@@ -91,7 +93,8 @@ void make_modes(const std::vector<Candidate>& candidates, const std::vector<Indi
 /// evidence on `indicator` (a power-like mode indicator on s.frequency_hz; the cluster's damping widened by an
 /// exponential window's `decay`), a shape from `shape_of` for the clusters with enough support to be checked,
 /// the checks, and s.modes (shapes as given, before any final re-estimation).
-void select_modes(const OrderPoles& poles, double lo, double hi, const IdentificationOptions& o, const Eigen::VectorXd& indicator, double decay,
+void select_modes(const OrderPoles& poles, double lo, double hi, const IdentificationOptions& o,
+                  const Eigen::VectorXd& indicator, double decay,
                   const std::function<Eigen::VectorXcd(const PoleCluster&)>& shape_of, IdentificationSummary& s);
 
 /// Clusters with at least this share of min_cluster_fraction get a shape and the evidence checks (weaker ones

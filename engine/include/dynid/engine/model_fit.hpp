@@ -159,9 +159,10 @@ Correlation correlate(const ParametricModel& pm, const ModalData& measured, cons
 /// model mode, where one bad mode could carry the fit. Updating applies it at the initial values, as discovery does
 /// at the model as given.
 struct PlausibleModes {
-  std::vector<int> paired;   ///< measured modes (0-based) with a plausible partner, ascending
-  std::vector<int> unpaired; ///< the others, ascending
-  Correlation correlation;   ///< every measured mode at theta (model_hz and mac of an unpaired one: the forced partner's)
+  std::vector<int> paired;    ///< measured modes (0-based) with a plausible partner, ascending
+  std::vector<int> unpaired;  ///< the others, ascending
+  Correlation
+      correlation;  ///< every measured mode at theta (model_hz and mac of an unpaired one: the forced partner's)
 };
 PlausibleModes plausible_modes(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta,
                                const FitOptions& options);
