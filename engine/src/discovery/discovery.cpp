@@ -92,7 +92,7 @@ void check_set_aside(const Problem& p, const ModalData& measured, const SetFit& 
   for (const SetAside& s : *aside)
     if (s.reason == SetAside::Reason::kNoPartner) idx.push_back(s.mode);
   if (idx.empty() || !f.ok) return;
-  ModalData d = select_modes(measured, idx);
+  ModalData d = modes_subset(measured, idx);
   d.damping_ratios.resize(0), d.mpc.resize(0), d.frequency_std_hz.resize(0), d.damping_std.resize(0), d.shape_std.resize(0);
   d.shape_entry_std.resize(0, 0);
   ParametricModel pm(*p.model);

@@ -21,32 +21,6 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
-ModalData select_modes(const ModalData& d, const std::vector<int>& keep) {
-  ModalData o = d;
-  const Eigen::Index n = static_cast<Eigen::Index>(keep.size());
-  o.frequencies_hz.resize(n);
-  o.shapes.resize(d.shapes.rows(), n);
-  for (Eigen::Index j = 0; j < n; ++j) {
-    o.frequencies_hz[j] = d.frequencies_hz[keep[static_cast<std::size_t>(j)]];
-    o.shapes.col(j) = d.shapes.col(keep[static_cast<std::size_t>(j)]);
-  }
-  auto pick = [&](const Eigen::VectorXd& src, Eigen::VectorXd* dst) {
-    if (src.size() != d.frequencies_hz.size()) return;
-    dst->resize(n);
-    for (Eigen::Index j = 0; j < n; ++j) (*dst)[j] = src[keep[static_cast<std::size_t>(j)]];
-  };
-  pick(d.damping_ratios, &o.damping_ratios);
-  pick(d.mpc, &o.mpc);
-  pick(d.frequency_std_hz, &o.frequency_std_hz);
-  pick(d.damping_std, &o.damping_std);
-  pick(d.shape_std, &o.shape_std);
-  if (d.shape_entry_std.cols() == d.frequencies_hz.size() && d.shape_entry_std.size() > 0) {
-    o.shape_entry_std.resize(d.shapes.rows(), n);
-    for (Eigen::Index j = 0; j < n; ++j) o.shape_entry_std.col(j) = d.shape_entry_std.col(keep[static_cast<std::size_t>(j)]);
-  }
-  return o;
-}
-
 NoiseModel noise_model(const ModalData& data, const DiscoveryOptions& o, std::vector<std::string>* warnings) {
   NoiseModel nm;
   const int p = data.num_modes();
@@ -151,7 +125,7 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
     for (const SetAside& s : S->set_aside) aside = aside || s.mode == k;
     if (!aside) keep.push_back(k);
   }
-  ModalData used = select_modes(measured, keep);
+  ModalData used = modes_subset(measured, keep);
   {
     ParametricModel pm(model);
     const Correlation c = correlate(pm, used, pm.nominal(), p.fit);
@@ -172,7 +146,7 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
     keep = paired;
   }
   std::sort(S->set_aside.begin(), S->set_aside.end(), [](const SetAside& a, const SetAside& b) { return a.mode < b.mode; });
-  p.data = select_modes(measured, keep);
+  p.data = modes_subset(measured, keep);
   p.modes = p.data.num_modes();
   p.noise = noise_model(p.data, o, &S->warnings);
   S->noise = p.noise;
@@ -194,7 +168,7 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
   std::vector<int> lone;
   for (const SetAside& s : S->set_aside)
     if (s.reason == SetAside::Reason::kNoPartner) lone.push_back(s.mode);
-  p.unpartnered = select_modes(measured, lone);
+  p.unpartnered = modes_subset(measured, lone);
   p.unpartnered_edge.resize(static_cast<Eigen::Index>(lone.size()));
   // A mode no model mode pairs has, under the model, only a vague density: uniform over the plausible range of
   // its whitened residuals (frequency ratio within max_frequency_ratio, each shape entry within +-1 of the

@@ -68,8 +68,6 @@ struct SetFit {
 };
 
 // ---- prepare ----
-/// A copy of `d` with only the modes in `keep` (every per-mode field cut alike).
-ModalData select_modes(const ModalData& d, const std::vector<int>& keep);
 /// The noise model (stated, the data's own, or the conservative default with a warning).
 NoiseModel noise_model(const ModalData& data, const DiscoveryOptions& o, std::vector<std::string>* warnings);
 /// Free-free models: measured modes that are rigid-body motions on the test's suspension (below the first elastic
