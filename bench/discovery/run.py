@@ -59,26 +59,25 @@ def run_case(job):
                     seconds_generate=time.time() - t0, seconds_dynid=0.0)
     t1 = time.time()
     out_json, out_png = Path(folder) / "discover.json", Path(folder) / "discover.png"
-    if a.get("rescore"):   # score the result dynid wrote before (a scoring or report change), never run it
-        result = json.loads(out_json.read_text()) if out_json.exists() else None
-        sc = score.score(truth, result, None if result else "no discover.json")
-        sc.update(exit_code=None, seconds_generate=0.0, seconds_dynid=0.0,
-                  truth_effects=[e["description"] for e in truth["effects"]], dofs=truth["structure"]["dofs"],
-                  shift_pct=truth["shift_pct"], data=truth["data"])
-        return sc
-    cmd = [a["dynid"], "--threads", "1", "-q", "discover", str(folder), "--json", str(out_json),
-           "--plot", str(out_png), "--force"]
     result, rc = None, None
-    try:
-        p = subprocess.run(cmd, capture_output=True, text=True, timeout=a["timeout"])
-        rc = p.returncode
-        lines = [l for l in (p.stderr or "").splitlines() if l.strip()]
-        if rc in (0, 4) and out_json.exists():
+    if a.get("rescore"):   # score the result dynid wrote before (a scoring or report change), never run it
+        if out_json.exists():
             result = json.loads(out_json.read_text())
         else:
-            failure = f"exit {rc}: {lines[-1] if lines else '(no message)'}"
-    except subprocess.TimeoutExpired:
-        failure = f"timeout after {a['timeout']} s"
+            failure = "no discover.json"
+    else:
+        cmd = [a["dynid"], "--threads", "1", "-q", "discover", str(folder), "--json", str(out_json),
+               "--plot", str(out_png), "--force"]
+        try:
+            p = subprocess.run(cmd, capture_output=True, text=True, timeout=a["timeout"])
+            rc = p.returncode
+            lines = [l for l in (p.stderr or "").splitlines() if l.strip()]
+            if rc in (0, 4) and out_json.exists():
+                result = json.loads(out_json.read_text())
+            else:
+                failure = f"exit {rc}: {lines[-1] if lines else '(no message)'}"
+        except subprocess.TimeoutExpired:
+            failure = f"timeout after {a['timeout']} s"
     t2 = time.time()
     sc = score.score(truth, result, failure)
     sc.update(exit_code=rc, seconds_generate=t1 - t0, seconds_dynid=t2 - t1,
