@@ -320,5 +320,22 @@ TEST(Candidates, EveryKindSatisfiesTheInvariants) {
   EXPECT_GE(seen.size(), 13u);
 }
 
+// A semi-rigid joint is where members meet: on the portal (members in 3 elements each) its candidates sit at the
+// six joints above the bases and never at a node inside a member, where a hinge would be member damage.
+TEST(Candidates, SemiRigidJointsOnlyWhereMembersMeet) {
+  const Model m = make_frame2d(portal());
+  const ModalData meas = exact_modes(m, m, 4);
+  std::set<int> at;
+  for (const auto& c : candidate_library(m, meas, DiscoveryOptions{}))
+    if (c->kind() == "semi_rigid_joint") at.insert(c->site().nodes.at(0));
+  std::set<int> joints;
+  for (const Node& n : m.nodes()) {
+    const bool grid = std::abs(std::remainder(n.x[0], 4.0)) < 1e-9 && std::abs(std::remainder(n.x[1], 3.0)) < 1e-9;
+    if (grid && n.x[1] > 0) joints.insert(n.id);
+  }
+  EXPECT_EQ(joints.size(), 6u);
+  EXPECT_EQ(at, joints);
+}
+
 }  // namespace
 }  // namespace dynid

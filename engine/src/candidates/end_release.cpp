@@ -2,6 +2,7 @@
 // the member connects semi-rigidly (a rotational spring between member end and joint); at a support with one
 // member the support is not rigid (a spring between member end and ground).
 #include <complex>
+#include <set>
 
 #include "candidates/common.hpp"
 
@@ -112,8 +113,15 @@ CandidateKind semi_rigid_joint_kind() {
           [](const CandidateContext& c) {
             std::vector<std::unique_ptr<Candidate>> out;
             const Model& m = *c.model;
+            // A joint is where two or more members meet: a node inside one member (two of its elements in line)
+            // connects nothing; a hinge there is damage of the member, which element_stiffness covers.
+            std::vector<int> member_of(static_cast<std::size_t>(m.num_elements()), -1);
+            for (std::size_t k = 0; k < c.members.size(); ++k)
+              for (int e : c.members[k]) member_of[static_cast<std::size_t>(e)] = static_cast<int>(k);
             for (int n = 0; n < static_cast<int>(m.nodes().size()); ++n) {
-              if (c.member_ends[n].size() < 2) continue;
+              std::set<int> members;
+              for (const auto& [e, k] : c.member_ends[n]) members.insert(member_of[static_cast<std::size_t>(e)]);
+              if (members.size() < 2) continue;
               for (int t = 3; t < kNumDofTypes; ++t) {
                 const Dof d = static_cast<Dof>(t);
                 if (m.dof_map().eq(n, d) < 0) continue;
