@@ -204,7 +204,8 @@ Selection select(const Problem& p, const std::vector<SetFit>& singles, const Fit
   }
   update_best();
 
-  // Walk each chain: each step must be worth it, and earlier effects must keep their place.
+  // Walk each chain: each step must be worth it, and earlier effects must keep their place. Every state the walk
+  // passes is a result (a chain's start can be a better explanation of its size than where another chain ends).
   std::vector<ChainResult> results;
   for (const auto& chain : chains) {
     ChainResult r;
@@ -213,6 +214,7 @@ Selection select(const Problem& p, const std::vector<SetFit>& singles, const Fit
     for (std::size_t j = 1; j < chain.size(); ++j) {
       const SetFit* next = s.find(chain[j]->set);
       if (!s.worth(*cur, *next)) break;
+      if (s.evidence(*cur) >= p.options.decisive) results.push_back({cur, r.steps});
       const Candidate* added = next->set.back();
       r.steps.push_back(step_of(s, SelectionStep::Action::kAdd, added->description(), *next));
       cur = next;
