@@ -1,5 +1,6 @@
 // Bad case files: each error names the file, line and entity, and says what is wrong.
 #include "dynid/io/case_file.hpp"
+#include "dynid/io/results_json.hpp"
 #include "dynid/mesh/error.hpp"
 #include "test_util.hpp"
 
@@ -38,6 +39,28 @@ std::string Replace(std::string s, const std::string& from, const std::string& t
 
 
 TEST(CaseErrors, GoodCaseParses) { EXPECT_EQ(Error(kGood), "(no error)"); }
+
+// Identified modes that the MPC filter leaves fewer than two of: the error names the source, the modes left out
+// with their MPC and the threshold, and what would help (not the engine's bare "at least 2 measured modes").
+TEST(CaseErrors, ComplexModesLeaveTooFewForDiscovery) {
+  const Case c = parse_case(std::string(kGood) + "discover:\n  measured: modes.uff\n", "case.yaml");
+  ModalData m;
+  m.dofs = {{2, Dof::UX}, {2, Dof::UY}};
+  m.frequencies_hz = Eigen::Vector3d(19.56, 21.76, 24.01);
+  m.shapes = Eigen::MatrixXd::Identity(2, 3);
+  m.mpc = Eigen::Vector3d(0.99, 0.76, 0.72);
+  std::string e = "(no error)";
+  try {
+    discovery_data(c, m, "rec.uff");
+  } catch (const InputError& x) {
+    e = x.what();
+  }
+  EXPECT_HAS(e, "rec.uff: discover: only 1 of the 3 modes is a normal mode");
+  EXPECT_HAS(e, "21.76 Hz (MPC 0.76), 24.01 Hz (MPC 0.72)");
+  EXPECT_HAS(e, "min_mpc = 0.8");
+  m.mpc[1] = 0.9;  // two normal modes: enough
+  EXPECT_EQ(discovery_data(c, m, "rec.uff").measured.num_modes(), 2);
+}
 
 TEST(CaseErrors, UnknownElementType) {
   const std::string e = Error(Replace(kGood, "element: frame2d", "element: frame4d"));

@@ -189,15 +189,28 @@ namespace dynid {
 namespace {
 using internal::format_number;
 
-ModalData keep_modes(ModalData m, const DiscoverSpec& d, std::vector<std::string>* notes) {
+ModalData keep_modes(ModalData m, const DiscoverSpec& d, const std::string& source, std::vector<std::string>* notes) {
   std::vector<int> keep;
+  std::string left_out;
   for (int k = 0; k < m.num_modes(); ++k) {
     if (m.mpc.size() == m.frequencies_hz.size() && m.mpc[k] < d.min_mpc) {
-      if (notes) notes->push_back("identified mode at " + std::to_string(m.frequencies_hz[k]) + " Hz left out: MPC " + std::to_string(m.mpc[k]) + " < " + std::to_string(d.min_mpc) + " (not a normal mode)");
+      const std::string what = format_number(m.frequencies_hz[k], 5) + " Hz (MPC " + format_number(m.mpc[k], 3) + ")";
+      if (notes)
+        notes->push_back("identified mode at " + what + " left out: MPC < " + format_number(d.min_mpc, 3) +
+                         " (not a normal mode)");
+      left_out += (left_out.empty() ? "" : ", ") + what;
       continue;
     }
     keep.push_back(k);
   }
+  if (m.num_modes() >= 2 && keep.size() < 2)
+    throw InputError(
+        source + ": discover: " + (keep.empty() ? std::string("none") : "only 1") + " of the " +
+        std::to_string(m.num_modes()) + " modes is a normal mode; the others' shapes are complex (MPC below " +
+        "discover: min_mpc = " + format_number(d.min_mpc, 3) + "): " + left_out +
+        ". Discovery needs at least 2. Close modes or too few sensors make identified "
+        "shapes complex: more sensors or another band (discover: identify: band_hz) would help, or a lower "
+        "min_mpc if these are real modes.");
   if (d.modes > 0 && static_cast<int>(keep.size()) > d.modes) keep.resize(static_cast<std::size_t>(d.modes));
   return modes_subset(m, keep);
 }
@@ -277,7 +290,7 @@ DiscoveryData discovery_data(const Case& c, int seed_offset) {
     }
     identify_recordings_for(c, std::move(recs), &out);
   }
-  out.measured = keep_modes(std::move(out.measured), d, &out.notes);
+  out.measured = keep_modes(std::move(out.measured), d, out.source, &out.notes);
   return out;
 }
 
@@ -285,7 +298,7 @@ DiscoveryData discovery_data(const Case& c, ModalData measured, const std::strin
   require_section(c, c.discover.has_value(), "discover");
   DiscoveryData out;
   out.source = source;
-  out.measured = keep_modes(std::move(measured), *c.discover, &out.notes);
+  out.measured = keep_modes(std::move(measured), *c.discover, source, &out.notes);
   return out;
 }
 
@@ -295,7 +308,7 @@ DiscoveryData discovery_data(const Case& c, std::vector<Recording> recordings, c
   DiscoveryData out;
   out.source = source;
   identify_recordings_for(c, std::move(recordings), &out);
-  out.measured = keep_modes(std::move(out.measured), *c.discover, &out.notes);
+  out.measured = keep_modes(std::move(out.measured), *c.discover, source, &out.notes);
   return out;
 }
 
