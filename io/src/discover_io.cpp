@@ -183,6 +183,14 @@ std::string discovery_explanation(const DiscoverySummary& s) {
              " (ln Bayes factor " + format_number(s.combined.log_evidence, 3) + "; " + fit_words(s) +
              "), has a probability of only " + pct(s.probability) + " % against " + rivals_words(s) +
              ". More modes, or sensors at the competing sites (rotations or strains there), would decide.";
+    case VerdictReason::kSiteUncertain:
+      return "Missing physics of this kind, but the data cannot tell exactly where: " + findings_words(s) + ". " +
+             fit_words(s) + "; the findings remove " + pct(s.explained) +
+             " % of the misfit beyond the noise (ln Bayes factor " + format_number(s.combined.log_evidence, 3) +
+             " over the model as given). The kind is clear, the place is not: " +
+             "effects of this kind have a probability of " + pct(s.kind_probability) + " % in all, at these sites " +
+             pct(s.probability) + " %; the competing explanations: " + rivals_words(s) +
+             ". Sensors at the competing sites (rotations or strains there) would decide.";
     case VerdictReason::kExplained: {
       std::string w = "Missing physics: " + findings_words(s) + ". " + fit_words(s) + "; the findings remove " + pct(s.explained) +
                       " % of the misfit beyond the noise, decisively (ln Bayes factor " + format_number(s.combined.log_evidence, 3) +
@@ -318,6 +326,7 @@ nlohmann::ordered_json discovery_json(const Case& c, const DiscoveryData& d, con
                           {"explained", st.explained}, {"max_freq_error_pct", st.max_freq_error_pct}, {"mean_mac", st.mean_mac}});
   }
   j["probability"] = s.probability;
+  j["kind_probability"] = s.kind_probability;
   j["rivals"] = nlohmann::ordered_json::array();
   for (const ScoredHypothesis& h : s.rivals)
     j["rivals"].push_back({{"kinds", h.kind}, {"description", h.description}, {"log_evidence", or_null(true, h.log_evidence)},

@@ -124,11 +124,17 @@ def test_chain_finds_the_damage(chain_python):
 def test_discovery_probability_is_the_verdicts_rule():
     """Real data that cannot tell the stories apart (USC cantilever: three frequencies at one sensor): the stated
     probability is at most what the listed rivals alone leave (unlisted explanations only add odds against), the
-    verdict follows it (missing physics at >= 0.5, else inconclusive for rivals), and the prose says how sure."""
+    verdict follows the kind's probability (missing physics at >= 0.5, else inconclusive for rivals; site_uncertain
+    when the findings' own probability is below 0.5), and the prose says how sure."""
     r = dynid.discover(dynid.load_case(str(CASES / "real-usc-cantilever")))
     best = r["combined"]["log_evidence"]
     bound = 1.0 / (1.0 + sum(math.exp(x["log_evidence"] - best) for x in r["rivals"]))
     assert r["rivals"] and 0.0 < r["probability"] <= bound + 1e-12
-    assert (r["verdict"] == "missing_physics") == (r["probability"] >= 0.5)
-    if r["verdict"] == "missing_physics":
+    assert r["probability"] <= r["kind_probability"] <= 1.0
+    assert (r["verdict"] == "missing_physics") == (r["kind_probability"] >= 0.5)
+    if r["verdict"] == "missing_physics" and r["probability"] >= 0.5:
+        assert r["reason"] == "explained"
         assert f"a probability of {round(100 * r['probability'])} % against" in r["explanation"]
+    elif r["verdict"] == "missing_physics":
+        assert r["reason"] == "site_uncertain"
+        assert f"at these sites {round(100 * r['probability'])} %" in r["explanation"]

@@ -30,6 +30,8 @@ const char* to_string(VerdictReason r) {
     case VerdictReason::kNothingDecisive: return "nothing_decisive";
     case VerdictReason::kPartlyExplained: return "partly_explained";
     case VerdictReason::kRivals: return "rivals";
+    case VerdictReason::kSiteUncertain:
+      return "site_uncertain";
   }
   return "?";
 }
@@ -226,8 +228,15 @@ void weigh_rivals(const Problem& p, const Selection& sel, const std::vector<SetF
       if (std::none_of(a.begin(), a.end(), [&](const Candidate* x) { return like(x, f); })) return true;
     return false;
   };
+  auto kinds_of = [](const std::vector<const Candidate*>& a) {
+    std::vector<std::string> k;
+    for (const Candidate* c : a) k.push_back(c->kind());
+    std::sort(k.begin(), k.end());
+    return k;
+  };
+  const std::vector<std::string> found_kinds = kinds_of(sel.fit.set);
   const double best = S->combined.log_evidence;
-  double odds_against = std::exp(-best);
+  double odds_against = std::exp(-best), odds_same_kinds = 0, most_same_kinds = 0;
   std::vector<const SetFit*> others;
   for (const SetFit& a : sel.alternatives) others.push_back(&a);
   for (const SetFit& f : singles)
@@ -239,7 +248,12 @@ void weigh_rivals(const Problem& p, const Selection& sel, const std::vector<SetF
     std::sort(key.begin(), key.end());
     if (!seen.insert(key).second) continue;
     const double le = log_evidence(p, *a);
-    odds_against += std::exp(le - best);
+    if (kinds_of(a->set) == found_kinds) {
+      odds_same_kinds += std::exp(le - best);
+      most_same_kinds = std::max(most_same_kinds, std::exp(le - best));
+    } else {
+      odds_against += std::exp(le - best);
+    }
     if (le < best - p.options.ambiguity) continue;
     ScoredHypothesis h = score_fit(p, *a, 0, sel.chi2_best);
     std::vector<std::size_t> all(a->set.size());
@@ -254,16 +268,20 @@ void weigh_rivals(const Problem& p, const Selection& sel, const std::vector<SetF
   std::stable_sort(S->rivals.begin(), S->rivals.end(), [](const ScoredHypothesis& a, const ScoredHypothesis& b) {
     return a.log_evidence > b.log_evidence;
   });
-  S->probability = 1.0 / (1.0 + odds_against);
+  S->probability = 1.0 / (1.0 + odds_same_kinds + odds_against);
+  // The findings' kinds, wherever they sit; only while the findings are their kinds' most probable sites.
+  S->kind_probability =
+      most_same_kinds > 1 ? S->probability : (1.0 + odds_same_kinds) / (1.0 + odds_same_kinds + odds_against);
 }
 
-// The verdict on an explanation: missing physics when it is the most probable story and removes at least
-// `partial` of the misfit beyond the noise.
+// The verdict on an explanation: missing physics when its kinds are the most probable story (the findings' sites
+// the most probable for them; site_uncertain when another site of the same kinds is about as probable) and it
+// removes at least `partial` of the misfit beyond the noise.
 void decide(const Problem& p, const Selection& sel, DiscoverySummary* S) {
   const double noise_floor = static_cast<double>(p.n);
   const double absolute = p.chi2_0 > noise_floor ? (p.chi2_0 - sel.fit.chi2) / (p.chi2_0 - noise_floor) : 1.0;
   S->explained = std::clamp(absolute, 0.0, 1.0);
-  if (S->probability < p.options.min_probability) {
+  if (S->kind_probability < p.options.min_probability) {
     S->verdict = Verdict::kInconclusive;
     S->reason = VerdictReason::kRivals;
   } else if (absolute < p.options.partial) {
@@ -271,7 +289,7 @@ void decide(const Problem& p, const Selection& sel, DiscoverySummary* S) {
     S->reason = VerdictReason::kPartlyExplained;
   } else {
     S->verdict = Verdict::kMissingPhysics;
-    S->reason = VerdictReason::kExplained;
+    S->reason = S->probability < p.options.min_probability ? VerdictReason::kSiteUncertain : VerdictReason::kExplained;
   }
 }
 

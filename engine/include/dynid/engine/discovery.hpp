@@ -174,11 +174,12 @@ const char* to_string(Verdict v);  // "consistent", "missing_physics", "inconclu
 
 /// Why the verdict is what it is.
 enum class VerdictReason {
-  kWithinNoise,           ///< consistent: the model fits the data within the noise
-  kExplained,             ///< missing physics: the findings are decisive and explain the misfit
-  kNothingDecisive,       ///< inconclusive: a misfit no candidate explains decisively
-  kPartlyExplained,       ///< inconclusive: the best explanation leaves most of the misfit
-  kRivals,                ///< inconclusive: a different explanation fits about as well
+  kWithinNoise,      ///< consistent: the model fits the data within the noise
+  kExplained,        ///< missing physics: the findings are decisive and explain the misfit
+  kNothingDecisive,  ///< inconclusive: a misfit no candidate explains decisively
+  kPartlyExplained,  ///< inconclusive: the best explanation leaves most of the misfit
+  kRivals,           ///< inconclusive: a different explanation fits about as well
+  kSiteUncertain,    ///< missing physics of the findings' kinds, but where is uncertain (kind_probability)
 };
 const char* to_string(VerdictReason r);  // "within_noise", ...
 
@@ -205,6 +206,11 @@ struct DiscoverySummary {
   /// The findings' posterior probability among the explanations scored (DiscoveryOptions::min_probability); 1 when
   /// nothing else comes near, 0 when nothing was found.
   double probability = 0;
+  /// The probability that the missing physics is of the findings' kinds, wherever it sits: the findings and the
+  /// explanations of the same kinds at other sites, against every other explanation scored (>= probability).
+  /// Below min_probability for the findings but above it for their kinds, the verdict is missing physics with the
+  /// reason site_uncertain: the kind is clear, the place is not.
+  double kind_probability = 0;
   ScoredHypothesis recalibration;            ///< E and rho recalibrated globally (always scored)
   FitQuality before, after;
   /// Share of the model's misfit beyond the noise (chi-square above its expectation at the noise model's
