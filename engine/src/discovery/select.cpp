@@ -19,10 +19,11 @@ namespace dynid::internal {
 
 namespace {
 
-// A fit is no worse than the model as given when its largest frequency error grows by at most 0.1 % of itself and
-// its mean MAC falls by at most 0.001: below that, the scatter of a fit to noisy shapes (a shape noise of 3 % alone
-// moves a MAC by about 0.001), not a worse fit. bench/discovery/score.py counts a worsened fit by the same rule.
-constexpr double kFrequencyTolerance = 1e-3, kMacTolerance = 1e-3;
+// A fit is no worse than the model as given when its largest frequency error does not grow and its mean MAC falls
+// by at most 1e-4 (rounding). bench/discovery/score.py counts a worsened fit more leniently (0.1 % of the error,
+// 0.001 of MAC): that tolerance here let a stand-in effect lower the MAC by < 0.001 and take the first place in
+// cases/discovery/frame-two-effects (25 of 40 seeds as expected instead of 40) for one case gained on dev.
+constexpr double kFrequencyTolerance = 0, kMacTolerance = 1e-4;
 
 struct Search {
   const Problem& p;
