@@ -125,23 +125,21 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
     for (const SetAside& s : S->set_aside) aside = aside || s.mode == k;
     if (!aside) keep.push_back(k);
   }
-  ModalData used = modes_subset(measured, keep);
   {
     ParametricModel pm(model);
-    const Correlation c = correlate(pm, used, pm.nominal(), p.fit);
-    std::vector<int> paired;
-    for (std::size_t k = 0; k < keep.size(); ++k) {
-      if (c.model_mode[k] >= 0) {
-        paired.push_back(keep[k]);
-        partner.push_back(c.model_mode[k]);
-        continue;
-      }
+    const PlausibleModes pl = plausible_modes(pm, modes_subset(measured, keep), pm.nominal(), p.fit);
+    for (int k : pl.unpaired) {
       SetAside s;
-      s.mode = keep[k];
-      s.frequency_hz = measured.frequencies_hz[keep[k]];
+      s.mode = keep[static_cast<std::size_t>(k)];
+      s.frequency_hz = measured.frequencies_hz[s.mode];
       s.reason = SetAside::Reason::kNoPartner;
-      s.mac = c.mac[static_cast<Eigen::Index>(k)];
+      s.mac = pl.correlation.mac[k];
       S->set_aside.push_back(s);
+    }
+    std::vector<int> paired;
+    for (int k : pl.paired) {
+      paired.push_back(keep[static_cast<std::size_t>(k)]);
+      partner.push_back(pl.correlation.model_mode[static_cast<std::size_t>(k)]);
     }
     keep = paired;
   }
