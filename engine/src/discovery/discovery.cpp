@@ -247,12 +247,12 @@ void weigh_rivals(const Problem& p, const Selection& sel, const std::vector<SetF
     std::vector<const Candidate*> key(a->set.begin(), a->set.end());
     std::sort(key.begin(), key.end());
     if (!seen.insert(key).second) continue;
-    const double le = log_evidence(p, *a);
+    const double le = log_evidence(p, *a), odds = std::exp(le - best);
     if (kinds_of(a->set) == found_kinds) {
-      odds_same_kinds += std::exp(le - best);
-      most_same_kinds = std::max(most_same_kinds, std::exp(le - best));
+      odds_same_kinds += odds;
+      most_same_kinds = std::max(most_same_kinds, odds);
     } else {
-      odds_against += std::exp(le - best);
+      odds_against += odds;
     }
     if (le < best - p.options.ambiguity) continue;
     ScoredHypothesis h = score_fit(p, *a, 0, sel.chi2_best);
