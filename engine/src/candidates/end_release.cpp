@@ -18,12 +18,21 @@ using Cd = std::complex<double>;
 // it is the rigid connection. Derivatives by complex step (exact to rounding).
 class EndRelease : public Candidate {
  public:
-  EndRelease(const Model& m, int e, int end, Dof d, bool support)
+  // member_length: the length of the member (chain of elements) element e belongs to.
+  EndRelease(const Model& m, int e, int end, Dof d, bool support, double member_length)
       : e_(e), eid_(m.elements()[e].id), nid_(m.nodes()[m.element_nodes(e)[end]].id), dof_(d), support_(support) {
     const auto types = m.element_dof_types(e);
     for (std::size_t k = 0; k < types.size(); ++k)
       if (types[k].first == m.element_nodes(e)[end] && types[k].second == d) i_ = static_cast<int>(k);
-    if (i_ >= 0) kii_ = member(m, e).K(i_, i_);
+    const Member mb = member(m, e);
+    if (i_ >= 0) kii_ = mb.K(i_, i_);
+    // The element's end stiffness over the whole member's: (L / l)^p with p = 1 for a rotation or an axial
+    // translation (E I / l, E A / l), 3 for a transverse one (E I / l^3), so that the prior is the member's, not
+    // the mesh's.
+    const auto& n = m.element_nodes(e);
+    const Eigen::Vector3d axis = (m.nodes()[n[1]].x - m.nodes()[n[0]].x).normalized();
+    const bool transverse = !is_rotation(d) && std::abs(axis[static_cast<int>(d)]) < 0.9;
+    if (mb.L > 0 && member_length > mb.L) mscale_ = std::pow(member_length / mb.L, transverse ? 3.0 : 1.0);
   }
   bool ok() const { return i_ >= 0 && kii_ > 0; }
   std::string kind() const override { return support_ ? "flexible_support" : "semi_rigid_joint"; }
@@ -35,9 +44,12 @@ class EndRelease : public Candidate {
                           " (spring on " + std::string(dof_name(dof_)) + ")";
   }
   Site site() const override { return {{nid_}, {eid_}}; }
-  // Flexibility in units of the member end's own flexibility 1 / K_ii: 1 = a spring as stiff as the member end.
-  // Heavy-tailed prior: a connection anywhere from rigid to pinned (fixity 1 / (1 + flexibility) uniform).
-  std::vector<CandidateParameter> parameters() const override { return {{"flexibility", 0.0, 0.0, 100.0, 1.0, CandidateParameter::Prior::kHeavyTailed}}; }
+  // Flexibility in units of the element end's own flexibility 1 / K_ii. Heavy-tailed prior of median the whole
+  // member's end flexibility (mscale_ / K_ii): a connection anywhere from rigid to pinned, its fixity against
+  // the member 1 / (1 + flexibility / mscale_) uniform, whatever the mesh.
+  std::vector<CandidateParameter> parameters() const override {
+    return {{"flexibility", 0.0, 0.0, 100.0 * mscale_, mscale_, CandidateParameter::Prior::kHeavyTailed}};
+  }
 
   template <class S>
   static void condense(const Eigen::MatrixXd& B, const Eigen::MatrixXd& Mm, int i, S ct, Eigen::Matrix<S, -1, -1>* K,
@@ -95,8 +107,24 @@ class EndRelease : public Candidate {
   Dof dof_;
   bool support_;
   int i_ = -1;
-  double kii_ = 0;  // the member's stiffness on the released DOF: c = ctil / kii
+  double kii_ = 0;     // the element's stiffness on the released DOF: c = ctil / kii
+  double mscale_ = 1;  // K_ii of the element over that of the whole member
 };
+
+// Per element, the length of the member (CandidateContext::members) it belongs to; 0 for elements in none.
+std::vector<double> member_lengths(const CandidateContext& c) {
+  const Model& m = *c.model;
+  std::vector<double> out(static_cast<std::size_t>(m.num_elements()), 0.0);
+  for (const std::vector<int>& chain : c.members) {
+    double L = 0;
+    for (int e : chain) {
+      const auto& n = m.element_nodes(e);
+      L += (m.nodes()[n[1]].x - m.nodes()[n[0]].x).norm();
+    }
+    for (int e : chain) out[static_cast<std::size_t>(e)] = L;
+  }
+  return out;
+}
 
 // Whether rotation d at a member end is a bending rotation of the member (not a twist about its axis).
 bool bends(const Model& m, int e, Dof d) {
@@ -113,6 +141,7 @@ CandidateKind semi_rigid_joint_kind() {
           [](const CandidateContext& c) {
             std::vector<std::unique_ptr<Candidate>> out;
             const Model& m = *c.model;
+            const std::vector<double> length = member_lengths(c);
             // A joint is where two or more members meet: a node inside one member (two of its elements in line)
             // connects nothing; a hinge there is damage of the member, which element_stiffness covers.
             std::vector<int> member_of(static_cast<std::size_t>(m.num_elements()), -1);
@@ -127,7 +156,7 @@ CandidateKind semi_rigid_joint_kind() {
                 if (m.dof_map().eq(n, d) < 0) continue;
                 for (const auto& [e, k] : c.member_ends[n]) {
                   if (!bends(m, e, d)) continue;
-                  auto r = std::make_unique<EndRelease>(m, e, k, d, false);
+                  auto r = std::make_unique<EndRelease>(m, e, k, d, false, length[static_cast<std::size_t>(e)]);
                   if (r->ok()) out.push_back(std::move(r));
                 }
               }
@@ -142,6 +171,7 @@ CandidateKind flexible_support_kind() {
           [](const CandidateContext& c) {
             std::vector<std::unique_ptr<Candidate>> out;
             const Model& m = *c.model;
+            const std::vector<double> length = member_lengths(c);
             for (int n = 0; n < static_cast<int>(m.nodes().size()); ++n) {
               if (c.member_ends[n].size() != 1) continue;  // with several members a spring would need a new DOF
               const auto [e, k] = c.member_ends[n][0];
@@ -149,7 +179,7 @@ CandidateKind flexible_support_kind() {
                 const Dof d = static_cast<Dof>(t);
                 if (!(m.dof_map().active(n) & (1u << t)) || m.dof_map().eq(n, d) >= 0) continue;  // restrained only
                 if (is_rotation(d) && !bends(m, e, d)) continue;
-                auto r = std::make_unique<EndRelease>(m, e, k, d, true);
+                auto r = std::make_unique<EndRelease>(m, e, k, d, true, length[static_cast<std::size_t>(e)]);
                 if (r->ok()) out.push_back(std::move(r));
               }
             }
