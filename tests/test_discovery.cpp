@@ -233,6 +233,56 @@ TEST(Discovery, CandidateDerivativesMatchFiniteDifferences) {
                                 // E and rho, member damage, shear, preload, self-weight, distributed mass, sensor mass
 }
 
+// The units (prior medians) of springs, supports and preloads are physical, never the mesh's: the same on a
+// beam meshed with 8 and with 32 elements, and equal to closed forms. Data: each model's own first 4 modes.
+// - a spring at a cantilever's tip: 1 / sum_r phi_r^2 / omega_r^2 over the 4 modes = 3 E I / L^3 / 0.99950 (modes
+//   5 and up hold 0.05 % of the static tip flexibility: 4 L^3 / (beta_r^4 E I) each, beta_r L the cantilever's
+//   roots); tolerance 0.3 %, the 8-element mesh's error in the 4th mode's flexibility share;
+// - the support's rotational spring at the prior's median: the member's 4 E I / L (not the element's 4 E I / l);
+// - a preload in a simply supported beam: P_E / (1 + 1/4 + 1/9 + 1/16), each mode's eigenvalue moving by
+//   P / (r^2 P_E); tolerance 0.3 %, as for the spring.
+// Before, the spring's unit was K_ii (64 times larger on the finer mesh) and the support's 4 E I / l.
+TEST(Discovery, CandidateUnitsComeFromTheBandNotTheMesh) {
+  BeamSpec b;
+  b.length = 2.0;
+  b.material = steel();
+  b.section.name = "s";
+  b.section.A = 0.01;
+  b.section.Iz = 0.1 * 0.1 * 0.1 * 0.1 / 12;
+  const double EI = b.material.E * b.section.Iz, L = b.length;
+  const double euler = M_PI * M_PI * EI / (L * L);
+  for (int elements : {8, 32}) {
+    b.elements = elements;
+    for (BeamSupport support : {BeamSupport::Cantilever, BeamSupport::SimplySupported}) {
+      b.support = support;
+      const Model m = make_beam(b);
+      const ModalData meas = exact_modes(m, m, 4);
+      int checked = 0;
+      for (const auto& c : candidate_library(m, meas, DiscoveryOptions{})) {
+        const CandidateParameter q = c->parameters()[0];
+        auto value = [&](double th) {
+          return c->physical(Eigen::VectorXd::Constant(1, th), Eigen::VectorXd::Zero(1))[0].value;
+        };
+        const Site site = c->site();
+        if (support == BeamSupport::Cantilever && c->kind() == "grounded_spring" &&
+            site.nodes == std::vector<int>{elements + 1}) {
+          EXPECT_NEAR(value(1.0) / (3 * EI / (L * L * L) / 0.99950), 1.0, 3e-3) << elements << " elements";
+          ++checked;
+        } else if (support == BeamSupport::Cantilever && c->kind() == "flexible_support" &&
+                   c->description().find("rz") != std::string::npos) {
+          EXPECT_NEAR(value(q.prior_scale) / (4 * EI / L), 1.0, 1e-9) << elements << " elements";
+          ++checked;
+        } else if (support == BeamSupport::SimplySupported && c->kind() == "axial_preload") {
+          EXPECT_NEAR(value(1.0) / (euler / (1 + 1 / 4.0 + 1 / 9.0 + 1 / 16.0)), 1.0, 3e-3) << elements << " elements";
+          EXPECT_NEAR(q.lower, -0.9 * (1 + 1 / 4.0 + 1 / 9.0 + 1 / 16.0), 3e-3) << "compression stops at 0.9 P_E";
+          ++checked;
+        }
+      }
+      EXPECT_EQ(checked, support == BeamSupport::Cantilever ? 2 : 1) << elements << " elements";
+    }
+  }
+}
+
 // The Timoshenko candidate at alpha = 1/kappa against the element kernel's shear-deformable beam (an independent
 // implementation: the kernel builds the matrix from phi directly), and the preload candidate against elements
 // with an axial force: identical matrices, so identical eigenvalues (to rounding). alpha = 3 (kappa = 1/3, a
@@ -281,8 +331,8 @@ TEST(Discovery, ShearAndPreloadCandidatesMatchTheElementKernels) {
       th[0] = 3.0;  // 1 / kappa
       ref = &t2;
     } else if (c->kind() == "axial_preload") {
-      // The candidate's unit is the Euler load of the group's extent: pi^2 E I / L^2.
-      th[0] = 2.0e6 / (M_PI * M_PI * b.material.E * b.section.Iz / (b.length * b.length));
+      // The candidate's unit is its own (the band's, CandidateUnitsComeFromTheBandNotTheMesh): read it back.
+      th[0] = 2.0e6 / c->physical(Eigen::VectorXd::Ones(1), Eigen::VectorXd::Zero(1))[0].value;
       ref = &pre;
     } else {
       continue;

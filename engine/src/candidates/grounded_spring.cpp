@@ -17,7 +17,8 @@ class GroundedSpring : public Candidate {
            std::string(dof_name(dof_)) + " at node " + std::to_string(id_);
   }
   Site site() const override { return {{id_}, {}}; }
-  // Unit: the model's own stiffness on that DOF (K_ii).
+  // Unit: the stiffness the band's modes see on that DOF (CandidateContext::band_stiffness), not K_ii, which grows
+  // as the mesh is refined. Heavy-tailed prior of median 1: the spring's share k / (k + k_band) is uniform.
   std::vector<CandidateParameter> parameters() const override { return {{"stiffness", 0.0, 0.0, 100.0, 1.0, CandidateParameter::Prior::kHeavyTailed}}; }
   std::vector<CustomTerm> terms(const Model&, int first) const override {
     return {linear_term({eq_}, Eigen::MatrixXd::Constant(1, 1, kref_), {}, first)};
@@ -50,7 +51,7 @@ std::vector<std::unique_ptr<Candidate>> place(const CandidateContext& c, bool ro
       if (eq < 0 || is_rotation(d) != rotations) continue;
       if (rotations && c.member_ends[n].size() >= 2) continue;
       if (!rotations && m.free_free()) continue;
-      out.push_back(std::make_unique<GroundedSpring>(m, n, d, c.stiffness_diagonal[eq]));
+      out.push_back(std::make_unique<GroundedSpring>(m, n, d, c.band_stiffness[eq]));
     }
   }
   return out;

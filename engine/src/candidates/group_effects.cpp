@@ -24,27 +24,53 @@ class OnElements : public Candidate {
   Site site_;
 };
 
-// P int N'^T N' (the consistent geometric stiffness) on every element of the group; unit: the Euler load
-// pi^2 EI / Lg^2 of the group's extent Lg.
+// P int N'^T N' (the consistent geometric stiffness) on every element of the group. Unit: the force that shifts
+// the band's eigenvalues by 100 % in all, to first order (1 / sum_r phi_r^T G phi_r / omega_r^2, G the group's
+// geometric stiffness per unit force): a tie rod the data's modes hardly feel needs a large force, a strip a
+// small one, whatever the mesh. Without a band that feels the group: the Euler load pi^2 EI / Lg^2 of the group's
+// extent Lg. Compression stops at 0.9 of the lower of that Euler load and the band's first-order buckling load.
 class AxialPreload : public OnElements {
  public:
-  AxialPreload(const Model& m, std::string group, std::vector<int> els) : OnElements(m, std::move(group), std::move(els)) {
+  AxialPreload(const CandidateContext& c, std::string group, std::vector<int> els)
+      : OnElements(*c.model, std::move(group), std::move(els)) {
+    const Model& m = *c.model;
     double EI = 0;
     Eigen::Vector3d a = Eigen::Vector3d::Constant(1e300), b = -a;
+    Eigen::VectorXd sens = Eigen::VectorXd::Zero(c.band_modes.cols());
+    std::vector<int> dofs;
     for (int e : els_) {
       EI += member(m, e).EI / static_cast<double>(els_.size());
       for (int k = 0; k < 2; ++k) {
         a = a.cwiseMin(m.nodes()[m.element_nodes(e)[k]].x);
         b = b.cwiseMax(m.nodes()[m.element_nodes(e)[k]].x);
       }
+      if (sens.size() == 0) continue;
+      m.element_dofs(e, &dofs);
+      const Eigen::MatrixXd G = m.unit_geometric_stiffness(e);
+      Eigen::MatrixXd phi = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(dofs.size()), sens.size());
+      for (std::size_t i = 0; i < dofs.size(); ++i)
+        if (dofs[i] >= 0) phi.row(static_cast<Eigen::Index>(i)) = c.band_modes.row(dofs[i]);
+      sens += (phi.transpose() * G * phi).diagonal();
     }
     const double Lg = std::max((b - a).norm(), 1e-12);
-    pref_ = M_PI * M_PI * EI / (Lg * Lg);
+    const double euler = M_PI * M_PI * EI / (Lg * Lg);
+    pref_ = euler;
+    double buckling = euler;
+    if (sens.size() > 0) {
+      sens = sens.cwiseQuotient(c.band_eigenvalues);
+      if (sens.sum() > 0) {
+        pref_ = 1.0 / sens.sum();
+        buckling = std::min(euler, 1.0 / sens.maxCoeff());
+      }
+    }
+    lower_ = -0.9 * buckling / pref_;
   }
   std::string kind() const override { return "axial_preload"; }
   Nature nature() const override { return Nature::kStiffness; }
   std::string description() const override { return "axial preload (geometric stiffness) in " + group_words(group_); }
-  std::vector<CandidateParameter> parameters() const override { return {{"force", 0.0, -0.9, 200.0, 20.0, CandidateParameter::Prior::kHeavyTailed}}; }
+  std::vector<CandidateParameter> parameters() const override {
+    return {{"force", 0.0, lower_, 100.0, 1.0, CandidateParameter::Prior::kHeavyTailed}};
+  }
   std::vector<CustomTerm> terms(const Model& m, int first) const override {
     std::vector<CustomTerm> out;
     for (int e : els_) {
@@ -63,13 +89,15 @@ class AxialPreload : public OnElements {
   }
 
  private:
-  double pref_ = 1;
+  double pref_ = 1, lower_ = -0.9;
 };
 
 // Translational mass rho A int N^T N added in proportion to the members' own: a fraction of the group's mass.
 class NonStructuralMass : public OnElements {
  public:
-  NonStructuralMass(const Model& m, std::string group, std::vector<int> els) : OnElements(m, std::move(group), std::move(els)) {
+  NonStructuralMass(const CandidateContext& c, std::string group, std::vector<int> els)
+      : OnElements(*c.model, std::move(group), std::move(els)) {
+    const Model& m = *c.model;
     double len = 0;
     for (int e : els_) {
       const Member mb = member(m, e);
@@ -107,7 +135,7 @@ std::vector<std::unique_ptr<Candidate>> per_group(const CandidateContext& c) {
   std::vector<std::unique_ptr<Candidate>> out;
   for (const std::string& g : member_groups(*c.model)) {
     std::vector<int> els = group_members(*c.model, g);
-    if (!els.empty()) out.push_back(std::make_unique<C>(*c.model, g, std::move(els)));
+    if (!els.empty()) out.push_back(std::make_unique<C>(c, g, std::move(els)));
   }
   return out;
 }

@@ -1,6 +1,7 @@
 // The candidate kinds dynid ships: one line per kind (each kind is one file in this folder).
 #include "candidates/registry.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <set>
@@ -84,7 +85,8 @@ std::vector<std::vector<int>> member_chains(const Model& m, const std::vector<st
 }  // namespace
 
 CandidateContext make_context(const Model& model, const ModalData& measured, const std::vector<int>& sensor_ids,
-                              const std::vector<int>& suspension_ids, const Eigen::Vector3d& gravity) {
+                              const std::vector<int>& suspension_ids, const Eigen::Vector3d& gravity,
+                              const std::vector<int>& band_modes) {
   CandidateContext c;
   c.model = &model;
   c.measured = &measured;
@@ -108,6 +110,37 @@ CandidateContext make_context(const Model& model, const ModalData& measured, con
   c.members = member_chains(model, c.member_ends);
   const AssembledSystem sys = assemble_system(model);
   c.stiffness_diagonal = sys.K.diagonal();
+  // The band: the model's elastic modes paired with the data (the first as many as the data hold if none given).
+  c.band_stiffness = c.stiffness_diagonal;
+  std::vector<int> band = band_modes;
+  if (band.empty())
+    for (int k = 0; k < measured.num_modes(); ++k) band.push_back(k);
+  if (!band.empty() && sys.K.rows() > 0) {
+    EigenOptions eo;
+    const int rigid = model.free_free() ? static_cast<int>(model.free_rigid_body_modes().cols()) : 0;
+    eo.num_modes =
+        static_cast<int>(std::min<Eigen::Index>(sys.K.rows(), rigid + *std::max_element(band.begin(), band.end()) + 1));
+    if (sys.K.rows() <= 400) eo.method = EigenOptions::Method::kDense;
+    const ModalResult r = modal_analysis(model, sys, eo);
+    std::vector<Eigen::Index> elastic;
+    for (Eigen::Index j = 0; r.ok() && j < r.eigenvalues.size(); ++j)
+      if (!r.rigid_body[static_cast<std::size_t>(j)] && r.eigenvalues[j] > 0) elastic.push_back(j);
+    std::set<int> unique(band.begin(), band.end());
+    std::vector<Eigen::Index> cols;
+    for (int k : unique)
+      if (k >= 0 && static_cast<std::size_t>(k) < elastic.size()) cols.push_back(elastic[static_cast<std::size_t>(k)]);
+    c.band_modes.resize(sys.K.rows(), static_cast<Eigen::Index>(cols.size()));
+    c.band_eigenvalues.resize(static_cast<Eigen::Index>(cols.size()));
+    for (std::size_t j = 0; j < cols.size(); ++j) {
+      c.band_modes.col(static_cast<Eigen::Index>(j)) = r.modes.col(cols[j]);
+      c.band_eigenvalues[static_cast<Eigen::Index>(j)] = r.eigenvalues[cols[j]];
+    }
+    Eigen::VectorXd flex = Eigen::VectorXd::Zero(sys.K.rows());
+    for (Eigen::Index j = 0; j < c.band_modes.cols(); ++j)
+      flex += c.band_modes.col(j).cwiseAbs2() / c.band_eigenvalues[j];
+    for (Eigen::Index i = 0; i < flex.size(); ++i)
+      if (flex[i] * c.stiffness_diagonal[i] > 1.0) c.band_stiffness[i] = 1.0 / flex[i];
+  }
   auto resolve = [&](const std::vector<int>& ids, const char* what) {
     std::vector<int> out;
     for (int id : ids) {

@@ -66,10 +66,11 @@ bool DiscoveryOptions::IsValid(std::string* why) const {
 
 std::vector<std::unique_ptr<Candidate>> candidate_library(const Model& model, const ModalData& measured,
                                                           const DiscoveryOptions& o) {
-  const CandidateContext c = internal::make_context(model, measured, o.sensor_nodes, o.suspension_nodes, o.gravity);
-  std::vector<CandidateKind> registry = builtin_candidate_kinds();
-  registry.insert(registry.end(), o.extra_kinds.begin(), o.extra_kinds.end());
-  return internal::place_candidates(c, registry, o.kinds);
+  // Exactly the library discover() places: the same pairing gives the candidates their units.
+  internal::Problem p;
+  DiscoverySummary S;
+  internal::prepare(model, measured, o, {}, &p, &S);
+  return std::move(p.library);
 }
 
 namespace {

@@ -181,7 +181,8 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
     p.unpartnered_edge.setConstant(gain(wf) + gain(ws) * static_cast<double>(measured.dofs.size()));
   }
 
-  p.context = make_context(model, p.data.num_modes() ? p.data : measured, o.sensor_nodes, o.suspension_nodes, o.gravity);
+  p.context = make_context(model, p.data.num_modes() ? p.data : measured, o.sensor_nodes, o.suspension_nodes, o.gravity,
+                           partner);
   p.context.measured = &p.data;
   p.context.gravity_acceleration = o.gravity_acceleration;
   std::vector<CandidateKind> registry = builtin_candidate_kinds();

@@ -85,6 +85,14 @@ struct CandidateContext {
   /// only they meet (element indices from one end to the other); a member of one element is a chain of one.
   std::vector<std::vector<int>> members;
   Eigen::VectorXd stiffness_diagonal;  ///< K_ii of the assembled model, per equation
+  /// The band: the model's elastic modes (free DOFs x r, mass-normalised) paired with the data, and their
+  /// eigenvalues omega^2. Candidates take their units from it (what the data can see), never from the mesh.
+  Eigen::MatrixXd band_modes;
+  Eigen::VectorXd band_eigenvalues;
+  /// Per equation, the stiffness the band's modes see there: 1 / sum_r phi_ir^2 / omega_r^2 over the band,
+  /// capped at K_ii. A spring this stiff shifts the band's eigenvalues by 100 % in all (first order); unlike K_ii it
+  /// does not grow as the mesh is refined.
+  Eigen::VectorXd band_stiffness;
   std::vector<int> sensor_nodes;       ///< node indices carrying sensors
   std::vector<int> suspension_nodes;   ///< free-free models: node indices of the suspension points
   Eigen::Vector3d gravity = Eigen::Vector3d(0, -1, 0);  ///< direction of gravity (unit)

@@ -228,7 +228,8 @@ struct DiscoverySummary {
 };
 
 /// The candidate library placed on a model: every candidate of the kinds in options.kinds (all if empty) among
-/// dynid's and options.extra_kinds. Exposed so host codes can inspect it.
+/// dynid's and options.extra_kinds, exactly as discover() places it (its units come from the model's modes paired
+/// with `measured`). Exposed so host codes can inspect it. Throws as discover() does on invalid options or data.
 std::vector<std::unique_ptr<Candidate>> candidate_library(const Model& model, const ModalData& measured,
                                                           const DiscoveryOptions& options);
 
