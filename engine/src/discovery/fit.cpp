@@ -40,7 +40,7 @@ FitQuality quality_of(const Problem& p, const Eigen::VectorXd& model_hz, const E
 
 namespace {
 
-// A single candidate's start: its magnitude parameter scanned over a few multiples of its prior scale (both ways
+// A single candidate's start: its magnitude parameter scanned over 1/64 to 16 times its prior scale (both ways
 // within the bounds), each point scored by its chi-square less the evidence of the unpartnered modes it pairs.
 // A local gradient method started at the nominal value finds the basin nearest the model as given; a mass that
 // creates a local mode, or a release that reorders modes, lies in another one.
@@ -57,7 +57,7 @@ Eigen::VectorXd scanned_start(const Problem& p, const ParametricModel& pm, const
     };
     double best_score = score(best);
     for (double sign : {1.0, -1.0})
-      for (double m : {0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0}) {
+      for (double m : {1.0 / 64, 1.0 / 16, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0}) {
         Eigen::VectorXd th = pm.nominal();
         th[0] = q.nominal + sign * m * scale;
         if (th[0] < q.lower || th[0] > q.upper) continue;
