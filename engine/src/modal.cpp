@@ -43,17 +43,24 @@ ModalResult modal_analysis(const Model& model, const AssembledSystem& sys, const
   return r;
 }
 
+ModalResult lowest_modes(const Model& model, int count) {
+  EigenOptions eo;
+  eo.num_modes = std::min(model.num_dofs(), count + 6);
+  if (model.num_dofs() <= 400) eo.method = EigenOptions::Method::kDense;
+  return modal_analysis(model, eo);
+}
+
 Eigen::VectorXd discretization_error(const Model& model, int count) {
+  return discretization_error(model, lowest_modes(model, count), count);
+}
+
+Eigen::VectorXd discretization_error(const Model& model, const ModalResult& coarse, int count) {
   auto elastic = [](const ModalResult& r) {
     std::vector<Eigen::Index> e;
     for (Eigen::Index j = 0; j < r.eigenvalues.size(); ++j)
       if (!r.rigid_body[j]) e.push_back(j);
     return e;
   };
-  EigenOptions eo;
-  eo.num_modes = std::min(model.num_dofs(), count + 6);
-  if (model.num_dofs() <= 400) eo.method = EigenOptions::Method::kDense;
-  const ModalResult coarse = modal_analysis(model, eo);
   const std::vector<Eigen::Index> ec = elastic(coarse);
   Eigen::VectorXd err = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(std::min<std::size_t>(ec.size(), static_cast<std::size_t>(count))));
   bool members = false;

@@ -86,7 +86,7 @@ std::vector<std::vector<int>> member_chains(const Model& m, const std::vector<st
 
 CandidateContext make_context(const Model& model, const ModalData& measured, const std::vector<int>& sensor_ids,
                               const std::vector<int>& suspension_ids, const Eigen::Vector3d& gravity,
-                              const std::vector<int>& band_modes) {
+                              const ModalResult& modes, const std::vector<int>& band_modes) {
   CandidateContext c;
   c.model = &model;
   c.measured = &measured;
@@ -116,15 +116,9 @@ CandidateContext make_context(const Model& model, const ModalData& measured, con
   if (band.empty())
     for (int k = 0; k < measured.num_modes(); ++k) band.push_back(k);
   if (!band.empty() && sys.K.rows() > 0) {
-    EigenOptions eo;
-    const int rigid = model.free_free() ? static_cast<int>(model.free_rigid_body_modes().cols()) : 0;
-    eo.num_modes =
-        static_cast<int>(std::min<Eigen::Index>(sys.K.rows(), rigid + *std::max_element(band.begin(), band.end()) + 1));
-    if (sys.K.rows() <= 400) eo.method = EigenOptions::Method::kDense;
-    const ModalResult r = modal_analysis(model, sys, eo);
     std::vector<Eigen::Index> elastic;
-    for (Eigen::Index j = 0; r.ok() && j < r.eigenvalues.size(); ++j)
-      if (!r.rigid_body[static_cast<std::size_t>(j)] && r.eigenvalues[j] > 0) elastic.push_back(j);
+    for (Eigen::Index j = 0; modes.ok() && j < modes.eigenvalues.size(); ++j)
+      if (!modes.rigid_body[static_cast<std::size_t>(j)] && modes.eigenvalues[j] > 0) elastic.push_back(j);
     std::set<int> unique(band.begin(), band.end());
     std::vector<Eigen::Index> cols;
     for (int k : unique)
@@ -132,8 +126,8 @@ CandidateContext make_context(const Model& model, const ModalData& measured, con
     c.band_modes.resize(sys.K.rows(), static_cast<Eigen::Index>(cols.size()));
     c.band_eigenvalues.resize(static_cast<Eigen::Index>(cols.size()));
     for (std::size_t j = 0; j < cols.size(); ++j) {
-      c.band_modes.col(static_cast<Eigen::Index>(j)) = r.modes.col(cols[j]);
-      c.band_eigenvalues[static_cast<Eigen::Index>(j)] = r.eigenvalues[cols[j]];
+      c.band_modes.col(static_cast<Eigen::Index>(j)) = modes.modes.col(cols[j]);
+      c.band_eigenvalues[static_cast<Eigen::Index>(j)] = modes.eigenvalues[cols[j]];
     }
     Eigen::VectorXd flex = Eigen::VectorXd::Zero(sys.K.rows());
     for (Eigen::Index j = 0; j < c.band_modes.cols(); ++j)

@@ -6,17 +6,19 @@
 #include <vector>
 
 #include "dynid/engine/candidate.hpp"
+#include "dynid/engine/modal.hpp"
 
 namespace dynid::internal {
 
 /// The context of a discovery: scales, members, sensors, suspension points and gravity of `model`.
 /// `sensor_nodes`, `suspension_nodes`: user ids (empty = the measured nodes; the two nodes farthest apart);
-/// `gravity`: a direction (zero = -y for plane models, -z for space models); `band_modes`: the model's elastic modes
-/// (0-based, rigid-body modes not counted) paired with the data (empty: the first as many as `measured` holds).
-/// Throws InputError for unknown nodes.
+/// `gravity`: a direction (zero = -y for plane models, -z for space models); `modes`: the model's lowest modes
+/// (lowest_modes(), solved once by the caller); `band_modes`: those of its elastic modes (0-based, rigid-body modes
+/// not counted) paired with the data (empty: the first as many as `measured` holds). Throws InputError for unknown
+/// nodes.
 CandidateContext make_context(const Model& model, const ModalData& measured, const std::vector<int>& sensor_nodes,
                               const std::vector<int>& suspension_nodes, const Eigen::Vector3d& gravity,
-                              const std::vector<int>& band_modes);
+                              const ModalResult& modes, const std::vector<int>& band_modes);
 
 /// Every candidate of the kinds named in `kinds` (empty = all) among `registry`, placed on the model. Throws
 /// InputError naming a kind that is not in the registry, with the known ones.

@@ -148,9 +148,12 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
   p.modes = p.data.num_modes();
   p.noise = noise_model(p.data, o, &S->warnings);
   S->noise = p.noise;
+  // The model's lowest modes, solved once: for its discretisation error and for the candidates' units.
+  const int count = partner.empty() ? measured.num_modes() : *std::max_element(partner.begin(), partner.end()) + 1;
+  const ModalResult modes = lowest_modes(model, count);
   // The model's own discretisation error joins the frequency noise, mode by mode.
   if (!partner.empty()) {
-    const Eigen::VectorXd disc = discretization_error(model, *std::max_element(partner.begin(), partner.end()) + 1);
+    const Eigen::VectorXd disc = discretization_error(model, modes, count);
     p.noise.discretization.resize(p.modes);
     for (int k = 0; k < p.modes; ++k) p.noise.discretization[k] = partner[static_cast<std::size_t>(k)] < disc.size() ? disc[partner[static_cast<std::size_t>(k)]] : 0.0;
     if (p.noise.discretization.maxCoeff() > 0) {
@@ -182,7 +185,7 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
   }
 
   p.context = make_context(model, p.data.num_modes() ? p.data : measured, o.sensor_nodes, o.suspension_nodes, o.gravity,
-                           partner);
+                           modes, partner);
   p.context.measured = &p.data;
   p.context.gravity_acceleration = o.gravity_acceleration;
   std::vector<CandidateKind> registry = builtin_candidate_kinds();

@@ -46,6 +46,10 @@ ModalResult modal_analysis(const Model& model, const AssembledSystem& system, co
 /// |f - f_refined| / f, about the error of f itself for cubic elements (errors fall 16-fold per halving), 0 for a
 /// mode without a partner of MAC 0.9. Models without beams or frames (matrix models) give zeros.
 Eigen::VectorXd discretization_error(const Model& model, int count);
+/// The model's lowest modes as discretization_error solves them (`count` + 6 modes, rigid-body ones included).
+ModalResult lowest_modes(const Model& model, int count);
+/// Same, on those modes already solved (lowest_modes(model, count)), so that a caller needing them too solves once.
+Eigen::VectorXd discretization_error(const Model& model, const ModalResult& coarse, int count);
 
 inline double eigenvalue_to_hz(double lambda) {
   return lambda > 0 ? std::sqrt(lambda) / (2.0 * 3.14159265358979323846) : 0.0;
