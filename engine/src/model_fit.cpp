@@ -99,7 +99,6 @@ class Evaluator {
     for (int p = 0; p < pm.num_parameters(); ++p)  // springs (and custom terms) may tie a free-free model down
       springs = springs || pm.parameter(p).kind == ParameterKind::kSpring || pm.parameter(p).kind == ParameterKind::kCustom;
     EigenOptions& eo = solver_.options();
-    eo.warm_start = EigenOptions::WarmStart::kBlockKrylov;  // each evaluation starts from the last one's modes
     // Free-free models: the rigid-body motions are deflated while K leaves them free; springs (and custom terms,
     // e.g. a suspension) may tie them down at some parameters, so each solve checks (solve()).
     if (model.free_free()) rigid_basis_ = model.free_rigid_body_modes();

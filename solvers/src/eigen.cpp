@@ -11,8 +11,6 @@
 #include <numeric>
 #include <random>
 #include <sstream>
-#include <cstdio>
-#include <cstdlib>
 
 #include "dynid/mesh/error.hpp"
 #include "dynid/solvers/cholmod.hpp"
@@ -156,94 +154,6 @@ void check_finite(const double* v, Eigen::Index n, const char* name) {
 bool in_band(double lam, const EigenOptions& o) { return lam >= o.band_lo && lam <= o.band_hi; }
 bool band_mode(const EigenOptions& o) { return !std::isnan(o.band_lo); }
 
-
-// Block M-orthonormalisation: Q <- Q minus its M-projection on the M-orthonormal basis V (MV = M V), twice; then
-// an M-orthonormal basis of what is left, from the eigen-decomposition of its M-Gram matrix (directions with
-// relative weight below 1e-10 are dropped: a nearly dependent block loses columns instead of failing).
-void m_orth_block(const SparseMatrix& M, const Eigen::MatrixXd& V, const Eigen::MatrixXd& MV, Eigen::MatrixXd* Q,
-                  Eigen::MatrixXd* MQ) {
-  const Eigen::Index n = Q->rows();
-  for (int pass = 0; pass < 2 && V.cols() > 0; ++pass) Q->noalias() -= V * (MV.transpose() * *Q);
-  MQ->resize(n, Q->cols());
-  for (Eigen::Index j = 0; j < Q->cols(); ++j) symmetric_multiply(M, Q->col(j).data(), MQ->col(j).data());
-  const Eigen::MatrixXd G = Q->transpose() * *MQ;
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (G + G.transpose()));
-  const Eigen::VectorXd d = es.eigenvalues();
-  const double dmax = d.size() ? d.maxCoeff() : 0.0;
-  std::vector<Eigen::Index> keep;
-  for (Eigen::Index i = 0; i < d.size(); ++i)
-    if (d[i] > 1e-10 * dmax && d[i] > 0) keep.push_back(i);
-  Eigen::MatrixXd T(Q->cols(), static_cast<Eigen::Index>(keep.size()));
-  for (std::size_t k = 0; k < keep.size(); ++k)
-    T.col(static_cast<Eigen::Index>(k)) = es.eigenvectors().col(keep[k]) / std::sqrt(d[keep[k]]);
-  *Q = *Q * T;
-  *MQ = *MQ * T;
-}
-
-// Warm start (EigenOptions::WarmStart::kBlockKrylov): block shift-invert Lanczos from X0 (previous modes and guard
-// vectors) with full reorthogonalisation in the M inner product, on the factor F of K - sigma M. Each step: W =
-// S Q (one block solve), Rayleigh-Ritz with H = V^T M S V, the wanted Ritz pairs' true residuals S y - theta y.
-// Returns false if they do not all meet the tolerance within opt.warm_steps steps.
-bool warm_lanczos(const CholmodFactor& F, const SparseMatrix& M, double sigma, const Eigen::MatrixXd& X0,
-                  const Eigen::MatrixXd& Phi, const Eigen::MatrixXd& MPhi, int nev, const EigenOptions& opt,
-                  Eigen::VectorXd* lam, Eigen::MatrixXd* modes, EigenSummary* sum) {
-  const Eigen::Index n = X0.rows();
-  auto deflate = [&](Eigen::MatrixXd* W) {
-    if (Phi.cols() > 0) W->noalias() -= Phi * (MPhi.transpose() * *W);
-  };
-  Eigen::MatrixXd V(n, 0), MV(n, 0), SV(n, 0), Q = X0, MQ, W, MW;
-  deflate(&Q);
-  m_orth_block(M, V, MV, &Q, &MQ);
-  for (int step = 1; step <= opt.warm_steps && Q.cols() > 0; ++step) {
-    F.solve_block(MQ, &W);  // W = (K - sigma M)^{-1} M Q
-    deflate(&W);
-    sum->solves += static_cast<int>(Q.cols());
-    const Eigen::Index k0 = V.cols(), b = Q.cols();
-    V.conservativeResize(n, k0 + b);
-    MV.conservativeResize(n, k0 + b);
-    SV.conservativeResize(n, k0 + b);
-    V.rightCols(b) = Q;
-    MV.rightCols(b) = MQ;
-    SV.rightCols(b) = W;
-    if (V.cols() < nev) {
-      Q = W;
-      m_orth_block(M, V, MV, &Q, &MQ);
-      continue;
-    }
-    const Eigen::MatrixXd H = MV.transpose() * SV;
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (H + H.transpose()));
-    // theta descending = lambda ascending (sigma below the wanted eigenvalues).
-    const Eigen::Index k = V.cols();
-    Eigen::MatrixXd S(k, nev);
-    Eigen::VectorXd th(nev);
-    for (int i = 0; i < nev; ++i) {
-      th[i] = es.eigenvalues()[k - 1 - i];
-      S.col(i) = es.eigenvectors().col(k - 1 - i);
-    }
-    Eigen::MatrixXd R = SV * S - (V * S) * th.asDiagonal();  // S y - theta y for the wanted pairs
-    bool ok = th.minCoeff() > 0;
-    double worst = 0;
-    for (int i = 0; i < nev; ++i) {
-      Eigen::VectorXd mr(n);
-      symmetric_multiply(M, R.col(i).data(), mr.data());
-      const double q = std::sqrt(std::max(0.0, R.col(i).dot(mr))) / (opt.tolerance * th[i]);
-      worst = std::max(worst, q);
-      ok = ok && q <= 1;
-    }
-    if (std::getenv("DYNID_WARM_DEBUG")) std::fprintf(stderr, "warm step %d: k=%ld worst residual/(tol theta) %.3g\n", step, (long)k, worst);
-    if (ok) {
-      sum->warm_steps = step;
-      lam->resize(nev);
-      for (int i = 0; i < nev; ++i) (*lam)[i] = sigma + 1.0 / th[i];
-      *modes = V * S;  // M-orthonormal: V is, and S has orthonormal columns
-      return true;
-    }
-    Q = W;  // the next block: what S added to the space
-    m_orth_block(M, V, MV, &Q, &MQ);
-  }
-  return false;
-}
-
 }  // namespace
 
 namespace detail {
@@ -338,7 +248,6 @@ bool EigenOptions::IsValid(std::string* why) const {
   if (backend == Backend::kDistributed && lo)
     return fail("the distributed backend solves the lowest modes only; a band needs the local backend");
   if (!(iterative_tolerance > 0 && iterative_tolerance < 1)) return fail("iterative_tolerance must be in (0, 1)");
-  if (warm_guard < 0 || warm_steps < 1) return fail("warm_guard must be >= 0 and warm_steps >= 1");
   return true;
 }
 
@@ -447,7 +356,6 @@ struct EigenSolver::Cache {
   std::unique_ptr<CholmodFactor> factor[2];  // [0] LL^T, [1] LDL^T
   bool llt_valid = false;                    // factor[0] holds K - sigma M of the last solve
   std::vector<int> outer[2], inner[2];       // the pattern each was analysed for
-  Eigen::MatrixXd warm;                      // the last solve's elastic modes (warm start)
   CholmodFactor& get(CholmodFactor::Kind kind, const SparseMatrix& A, double* t_analyze) {
     const int k = kind == CholmodFactor::Kind::kSupernodalLLt ? 0 : 1;
     const int n = static_cast<int>(A.cols());
@@ -645,27 +553,7 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
     auto tl = Clock::now();
     const int n_eff = static_cast<int>(n - r);
     int extra = band ? 2 : 0;
-    const bool warm = !band && opt.warm_start == EigenOptions::WarmStart::kBlockKrylov &&
-                      cache_->warm.rows() == n && cache_->warm.cols() >= nev && nev + opt.warm_guard < n_eff / 2;
-    if (warm) {
-      report(opt, "lanczos", -1);
-      Eigen::MatrixXd X0(n, nev + opt.warm_guard);
-      X0.leftCols(nev) = cache_->warm.leftCols(nev);
-      std::mt19937_64 rng(20241121);
-      std::uniform_real_distribution<double> u(-1.0, 1.0);
-      for (Eigen::Index j = nev; j < X0.cols(); ++j)
-        for (Eigen::Index i = 0; i < n; ++i) X0(i, j) = u(rng);
-      Eigen::VectorXd ev;
-      if (warm_lanczos(F, Mu, sigma, X0, Phi, MPhi, nev, opt, &ev, &elastic, &sum)) {
-        for (int k = 0; k < nev; ++k) {
-          lam.push_back(ev[k]);
-          elastic_keep.push_back(k);
-          rigid.push_back(0);
-        }
-        extra = -1;  // done: no fresh run
-      }
-    }
-    for (int attempt = 0; attempt < 3 && extra >= 0; ++attempt) {
+    for (int attempt = 0; attempt < 3; ++attempt) {
       const int want = std::min(nev + extra, n_eff - 1);
       int ncv = opt.subspace > 0 ? opt.subspace : std::max(2 * want + 1, want + 20);
       ncv = std::min(ncv, n_eff);
@@ -785,11 +673,6 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
   }
   sum.status = converged ? EigenStatus::kSuccess : EigenStatus::kNotConverged;
   cache_->llt_valid = !band && nev > 0;  // F holds K - sigma M (LL^T)
-  if (opt.warm_start != EigenOptions::WarmStart::kNone && !band && sum.status == EigenStatus::kSuccess) {
-    cache_->warm.resize(n, m - std::count(sol.rigid_body.begin(), sol.rigid_body.end(), 1));
-    for (Eigen::Index k = 0, j = 0; k < m; ++k)
-      if (!sol.rigid_body[k]) cache_->warm.col(j++) = sol.modes.col(k);
-  }
   report(opt, "done", 1.0);
   return sol;
 }

@@ -56,19 +56,6 @@ struct EigenOptions {
   enum class Method { kAuto, kSparse, kDense };
   /// kAuto: dense for n <= 300 (or when the wanted modes approach n), sparse otherwise.
   Method method = Method::kAuto;
-  /// EigenSolver only, lowest-modes mode: reuse the previous solve's modes (model updating, where each solve
-  /// differs little from the last; the symbolic analysis is reused in any case).
-  ///  kNone: a fresh Lanczos run every time (default).
-  ///  kBlockKrylov: block shift-invert Lanczos started from the previous elastic modes plus `warm_guard` random
-  ///    vectors, one block solve (BLAS-3) per step, Rayleigh-Ritz on the block Krylov space, up to `warm_steps`
-  ///    steps; accepted when every wanted Ritz pair meets ||S y - theta y||_M <= tolerance * theta
-  ///    (S = (K - sigma M)^{-1} M, theta = 1 / (lambda - sigma): the fresh run's criterion, on the true residual),
-  ///    else the fresh run follows. A mode that the previous solve did not have and that enters below the wanted
-  ///    ones is found only through the guard vectors: use it where parameters change by small steps.
-  enum class WarmStart { kNone, kBlockKrylov };
-  WarmStart warm_start = WarmStart::kNone;
-  int warm_guard = 8;
-  int warm_steps = 12;
   /// Where the solve runs. kLocal: this process (CHOLMOD + Spectra, above). kDistributed: every rank of
   /// MPI_COMM_WORLD together (PETSc + SLEPc: Krylov-Schur shift-and-invert on a MUMPS Cholesky factorization, or on
   /// an iterative solve; solvers/distributed.hpp). Lowest-modes mode only (no band); dense is never used.
@@ -104,7 +91,6 @@ struct EigenSummary {
   double time_analyze = 0, time_factorize = 0, time_lanczos = 0;  ///< seconds
   double max_residual = 0;
   long long matrix_nonzeros = 0;  ///< distributed backend: nonzeros of K (all ranks); the local path leaves 0
-  int warm_steps = 0;             ///< block steps of an accepted warm start (0: a fresh Lanczos run)
   int ranks = 1;                  ///< MPI ranks that took part (distributed backend), else 1
   double time_assembly = 0;       ///< distributed backend: partition + this rank's assembly (seconds)
   double factor_memory_max_mb = 0;    ///< distributed: MUMPS's factorization memory on the largest rank (INFOG(21))
