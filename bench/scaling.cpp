@@ -9,6 +9,8 @@
 // PETSc counted (what -log_view reports; MUMPS's own messages inside the factorization are not counted there).
 //
 // Each measurement runs in its own child process so that peak memory (ru_maxrss) is that run's alone.
+#include <mpi.h>
+#include <petsclog.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -34,9 +36,6 @@
 #include "dynid/solvers/blas.hpp"
 #include "dynid/solvers/cholmod.hpp"
 #include "dynid/solvers/distributed.hpp"
-
-#include <mpi.h>
-#include <petsclog.h>
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
@@ -218,26 +217,29 @@ int DistributedTable(const std::vector<Spec>& specs, const std::string& only, co
                "factor entries (fill vs nnz(K)) | factor GFlop | MUMPS MB max rank / total | PETSc MPI MB (messages) | "
                "solves | max rel. diff of eigenvalues |\n"
             << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-  const std::string mpi = std::string(DYNID_MPIEXEC) + " --allow-run-as-root --oversubscribe -n " + std::to_string(ranks) +
-                          " -x OMP_NUM_THREADS=1 -x OPENBLAS_NUM_THREADS=1 ";
+  const std::string mpi = std::string(DYNID_MPIEXEC) + " --allow-run-as-root --oversubscribe -n " +
+                          std::to_string(ranks) + " -x OMP_NUM_THREADS=1 -x OPENBLAS_NUM_THREADS=1 ";
   for (std::size_t k = 0; k < specs.size(); ++k) {
     const Spec& s = specs[k];
     if (!only.empty() && s.name.find(only) == std::string::npos) continue;
     const json d = RunJson(self + " --child " + std::to_string(k) + " run", 3600);
     const json p = RunJson(mpi + self + " --child " + std::to_string(k) + " mpi", 3600);
     if (p.contains("error") || d.contains("error")) {
-      std::cout << "| " << s.name << " | local: " << d.value("error", "ok") << ", distributed: " << p.value("error", "ok") << " |" << std::endl;
+      std::cout << "| " << s.name << " | local: " << d.value("error", "ok")
+                << ", distributed: " << p.value("error", "ok") << " |" << std::endl;
       continue;
     }
     std::string per_rank;
-    for (const auto& v : p["peak_rss_mb_per_rank"]) per_rank += (per_rank.empty() ? "" : " / ") + Fmt(v.get<double>(), "%.0f");
+    for (const auto& v : p["peak_rss_mb_per_rank"])
+      per_rank += (per_rank.empty() ? "" : " / ") + Fmt(v.get<double>(), "%.0f");
     const double fill = p["factor_entries"].get<double>() / p["nnz"].get<double>();
     std::cout << "| " << s.name << " | " << p["dofs"] << " | " << ranks << " | " << Fmt(d["total_s"]) << " | "
               << Fmt(d["peak_rss_mb"], "%.0f") << " | " << Fmt(p["total_s"]) << " (" << Fmt(p["factorize_s"]) << " / "
-              << Fmt(p["lanczos_s"]) << ") | " << per_rank << " | " << Fmt(p["factor_entries"].get<double>(), "%.3g") << " ("
-              << Fmt(fill, "%.1f") << ") | " << Fmt(p["factor_gflop"], "%.0f") << " | " << p["mumps_mb_max_rank"] << " / "
-              << p["mumps_mb_total"] << " | " << Fmt(p["petsc_sent_mb"], "%.1f") << " (" << Fmt(p["petsc_messages"], "%.0f")
-              << ") | " << p["solves"] << " | " << Fmt(MaxRelDiff(d, p), "%.1e") << " |" << std::endl;
+              << Fmt(p["lanczos_s"]) << ") | " << per_rank << " | " << Fmt(p["factor_entries"].get<double>(), "%.3g")
+              << " (" << Fmt(fill, "%.1f") << ") | " << Fmt(p["factor_gflop"], "%.0f") << " | "
+              << p["mumps_mb_max_rank"] << " / " << p["mumps_mb_total"] << " | " << Fmt(p["petsc_sent_mb"], "%.1f")
+              << " (" << Fmt(p["petsc_messages"], "%.0f") << ") | " << p["solves"] << " | "
+              << Fmt(MaxRelDiff(d, p), "%.1e") << " |" << std::endl;
   }
   return 0;
 }
@@ -267,7 +269,8 @@ int main(int argc, char** argv) {
     else if (a == "--only" && i + 1 < argc) only = argv[++i];
     else if (a == "--workdir" && i + 1 < argc) workdir = argv[++i];
     else if (a == "--peer-timeout" && i + 1 < argc) peer_timeout = std::atoi(argv[++i]);
-    else if (a == "--ranks" && i + 1 < argc) ranks = std::atoi(argv[++i]);
+    else if (a == "--ranks" && i + 1 < argc)
+      ranks = std::atoi(argv[++i]);
     else if (a == "--child" && i + 2 < argc) {  // internal: --child INDEX run|export [dir]
       const Spec& s = specs.at(static_cast<std::size_t>(std::atoi(argv[++i])));
       const std::string what = argv[++i];
@@ -275,7 +278,8 @@ int main(int argc, char** argv) {
       if (what == "mpi") return RunDistributed(s);
       return ExportMatrices(s, argv[++i]);
     } else {
-      std::cerr << "usage: dynid_scaling [--quick] [--no-peers] [--only NAME-SUBSTRING] [--workdir DIR] [--peer-timeout S] [--ranks N]\n";
+      std::cerr << "usage: dynid_scaling [--quick] [--no-peers] [--only NAME-SUBSTRING] [--workdir DIR] "
+                   "[--peer-timeout S] [--ranks N]\n";
       return 2;
     }
   }

@@ -3,13 +3,13 @@
 // translations of 5 column lines on every floor (140 DOFs) with 0.1 % frequency and 1 % shape noise. Objective:
 // frequencies + shapes, with a weak prior toward nominal (std 0.2). Prints Ceres' iterations, the time per
 // iteration against one eigen-solve of the model, and the recovered factors' error.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
 #include <vector>
-#include <algorithm>
 
 #include "bench_common.hpp"
 #include "blas_kernels.hpp"

@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
-#include <thread>
 #include <iostream>
+#include <thread>
 
 #include "blas_kernels.hpp"
 #include "commands.hpp"

@@ -303,7 +303,9 @@ bool factor_statistics(EPS eps, EigenSummary* sum, std::string* why) {
   return true;
 }
 
-Eigen::VectorXd to_vector(const std::vector<double>& v) { return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())); }
+Eigen::VectorXd to_vector(const std::vector<double>& v) {
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+}
 
 EigenSolution solve_local_system(const LocalSystem& ls, const EigenOptions& opt) {
   EigenSolution sol;
@@ -373,8 +375,8 @@ EigenSolution solve_local_system(const LocalSystem& ls, const EigenOptions& opt)
   if (nev > 0) {
     if (nev > n - r - 1) {
       sum.status = EigenStatus::kInvalidInput;
-      sum.message = "too many modes requested for the distributed solver (" + std::to_string(opt.num_modes) +
-                    " of " + std::to_string(n) + " DOFs)";
+      sum.message = "too many modes requested for the distributed solver (" + std::to_string(opt.num_modes) + " of " +
+                    std::to_string(n) + " DOFs)";
       return sol;
     }
     EpsRun run;
@@ -406,7 +408,8 @@ EigenSolution solve_local_system(const LocalSystem& ls, const EigenOptions& opt)
     if (!ok) {
       sum.status = EigenStatus::kFactorizationFailed;
       sum.message = sigma == 0.0 ? "K is singular or not positive definite: the structure is a mechanism or is not "
-                                   "supported (" + run.why + ")"
+                                   "supported (" +
+                                       run.why + ")"
                                  : run.why;
       return sol;
     }
@@ -527,7 +530,8 @@ int distributed_size() {
 bool launched_with_several_ranks() {
   for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE", "MPI_LOCALNRANKS", "SLURM_NTASKS"}) {
     const char* s = std::getenv(v);
-    if (s && std::atoi(s) > 1) return std::string(v) != "SLURM_NTASKS" || std::getenv("PMI_RANK") || std::getenv("SLURM_PROCID");
+    if (s && std::atoi(s) > 1)
+      return std::string(v) != "SLURM_NTASKS" || std::getenv("PMI_RANK") || std::getenv("SLURM_PROCID");
   }
   return false;
 }
@@ -554,7 +558,8 @@ std::vector<int> partition_dofs(const ElementSource& src, int parts) {
   }
   // Supervariables: runs of consecutive DOFs with the same (sorted, unique) element list.
   auto list = [&](int d) {
-    std::vector<int> l(elems.begin() + cnt[static_cast<std::size_t>(d)], elems.begin() + cnt[static_cast<std::size_t>(d) + 1]);
+    std::vector<int> l(elems.begin() + cnt[static_cast<std::size_t>(d)],
+                       elems.begin() + cnt[static_cast<std::size_t>(d) + 1]);
     std::sort(l.begin(), l.end());
     l.erase(std::unique(l.begin(), l.end()), l.end());
     return l;
@@ -610,7 +615,9 @@ std::vector<int> partition_dofs(const ElementSource& src, int parts) {
   const int rc = METIS_PartGraphKway(&nsv, &ncon, xadj.data(), adjncy.data(), weight.data(), nullptr, nullptr, &np,
                                      nullptr, nullptr, options, &objval, where.data());
   if (rc != METIS_OK) throw InternalError("METIS_PartGraphKway failed (code " + std::to_string(rc) + ")");
-  for (int d = 0; d < n; ++d) part[static_cast<std::size_t>(d)] = static_cast<int>(where[static_cast<std::size_t>(sv[static_cast<std::size_t>(d)])]);
+  for (int d = 0; d < n; ++d)
+    part[static_cast<std::size_t>(d)] =
+        static_cast<int>(where[static_cast<std::size_t>(sv[static_cast<std::size_t>(d)])]);
   // METIS may leave a part empty on tiny graphs: then contiguous blocks.
   std::vector<int> used(static_cast<std::size_t>(parts), 0);
   for (int p : part) used[static_cast<std::size_t>(p)] = 1;
@@ -627,7 +634,8 @@ EigenSolution solve_eigen_distributed(const ElementSource& source, const EigenOp
   const int n = source.num_dofs();
   detail::check_inputs(n, n, n, n, options);
   if (!std::isnan(options.band_lo))
-    throw InputError("eigen-solve options: the distributed backend solves the lowest modes only; a band needs the local backend");
+    throw InputError(
+        "eigen-solve options: the distributed backend solves the lowest modes only; a band needs the local backend");
   start_distributed_runtime();
   const int size = distributed_size(), rank = distributed_rank();
   return guarded([&] { return solve_local_system(assemble_local(source, size, rank), options); });
@@ -636,7 +644,8 @@ EigenSolution solve_eigen_distributed(const ElementSource& source, const EigenOp
 EigenSolution solve_eigen_distributed(const SparseMatrix& K, const SparseMatrix& M, const EigenOptions& options) {
   detail::check_inputs(K.rows(), K.cols(), M.rows(), M.cols(), options);
   if (!std::isnan(options.band_lo))
-    throw InputError("eigen-solve options: the distributed backend solves the lowest modes only; a band needs the local backend");
+    throw InputError(
+        "eigen-solve options: the distributed backend solves the lowest modes only; a band needs the local backend");
   start_distributed_runtime();
   const int size = distributed_size(), rank = distributed_rank();
   return guarded([&] {

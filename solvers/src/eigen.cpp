@@ -1,16 +1,16 @@
 #include "dynid/solvers/eigen.hpp"
 
-#include <Eigen/Dense>
 #include <Spectra/SymEigsSolver.h>
-#include <stdexcept>
 #include <Spectra/SymGEigsShiftSolver.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <numeric>
 #include <random>
 #include <sstream>
+#include <stdexcept>
 
 #include "dynid/mesh/error.hpp"
 #include "dynid/solvers/cholmod.hpp"

@@ -90,9 +90,9 @@ struct EigenSummary {
   int num_rigid = 0;
   double time_analyze = 0, time_factorize = 0, time_lanczos = 0;  ///< seconds
   double max_residual = 0;
-  long long matrix_nonzeros = 0;  ///< distributed backend: nonzeros of K (all ranks); the local path leaves 0
-  int ranks = 1;                  ///< MPI ranks that took part (distributed backend), else 1
-  double time_assembly = 0;       ///< distributed backend: partition + this rank's assembly (seconds)
+  long long matrix_nonzeros = 0;      ///< distributed backend: nonzeros of K (all ranks); the local path leaves 0
+  int ranks = 1;                      ///< MPI ranks that took part (distributed backend), else 1
+  double time_assembly = 0;           ///< distributed backend: partition + this rank's assembly (seconds)
   double factor_memory_max_mb = 0;    ///< distributed: MUMPS's factorization memory on the largest rank (INFOG(21))
   double factor_memory_total_mb = 0;  ///< distributed: the same summed over the ranks (INFOG(22))
   bool ok() const { return status == EigenStatus::kSuccess; }
