@@ -528,10 +528,10 @@ int distributed_size() {
 }
 
 bool launched_with_several_ranks() {
-  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE", "MPI_LOCALNRANKS", "SLURM_NTASKS"}) {
+  // OpenMPI's mpirun, MPICH/Hydra's mpiexec (PMI_SIZE, MPI_LOCALNRANKS), Slurm's srun (inside a job step only).
+  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "MPI_LOCALNRANKS", "SLURM_STEP_NUM_TASKS"}) {
     const char* s = std::getenv(v);
-    if (s && std::atoi(s) > 1)
-      return std::string(v) != "SLURM_NTASKS" || std::getenv("PMI_RANK") || std::getenv("SLURM_PROCID");
+    if (s && std::atoi(s) > 1) return true;
   }
   return false;
 }

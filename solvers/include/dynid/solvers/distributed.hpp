@@ -31,7 +31,7 @@ void start_distributed_runtime();
 int distributed_rank();
 int distributed_size();
 /// True if this process was started by an MPI launcher with more than one rank (mpirun -n N, N > 1; OpenMPI,
-/// MPICH/Hydra, Slurm's PMI), read from the environment without starting MPI.
+/// MPICH/Hydra, srun), read from the environment without starting MPI.
 bool launched_with_several_ranks();
 
 /// The rank (0 .. parts-1) owning each DOF: a METIS k-way partition of the supervariable graph of `source`,
