@@ -368,6 +368,38 @@ std::size_t read_values(const Ctx& c, const Block& b, std::size_t k, std::size_t
   return k;
 }
 
+/// The node records of a 55 or 2414 data set from line k to the block's end: a node number (record
+/// `node_record`, I10) followed by `per_node` values (record node_record + 1; a short count is reported at the node
+/// line when `count_at_node`). Fills the node numbers and the values in file order.
+void read_node_values(const Ctx& c, const Block& b, std::size_t k, std::size_t per_node, int node_record, bool count_at_node,
+                      std::vector<int>* nodes, std::vector<double>* vals) {
+  while (k < b.lines.size()) {
+    if (trim(b.lines[k]).empty()) {
+      ++k;
+      continue;
+    }
+    int node = 0;
+    if (!parse_int(b.lines[k], &node))
+      c.fail(record_name(node_record), b.line_no[k], "expected a node number (I10), found '" + std::string(rtrim(b.lines[k])) + "'");
+    const int node_line = count_at_node ? b.line_no[k] : -1;
+    ++k;
+    k = read_values(c, b, k, per_node, node_record + 1, "node " + std::to_string(node), vals, node_line);
+    nodes->push_back(node);
+  }
+}
+
+/// Values (nodes x per node) from the numbers of read_node_values(): per node, real parts or (re, im) pairs.
+Eigen::MatrixXcd node_values(const std::vector<double>& vals, Eigen::Index nn, int values_per_node, bool complex) {
+  const std::size_t per_node = static_cast<std::size_t>(values_per_node) * (complex ? 2 : 1);
+  Eigen::MatrixXcd values(nn, values_per_node);
+  for (Eigen::Index i = 0; i < nn; ++i)
+    for (int j = 0; j < values_per_node; ++j) {
+      const std::size_t at = static_cast<std::size_t>(i) * per_node + static_cast<std::size_t>(complex ? 2 * j : j);
+      values(i, j) = std::complex<double>(vals[at], complex ? vals[at + 1] : 0.0);
+    }
+  return values;
+}
+
 Uff55 read55(const Ctx& c, const Block& b) {
   if (b.lines.size() < 8)
     c.fail(record_name(static_cast<int>(b.lines.size()) + 1), b.last_line,
@@ -393,28 +425,9 @@ Uff55 read55(const Ctx& c, const Block& b) {
   d.record8 = r8;
   const int per_node = d.values_per_node * (d.complex ? 2 : 1);
   std::vector<double> vals;
-  std::size_t k = 8;
-  while (k < b.lines.size()) {
-    if (trim(b.lines[k]).empty()) {
-      ++k;
-      continue;
-    }
-    int node = 0;
-    if (!parse_int(b.lines[k], &node))
-      c.fail(record_name(9), b.line_no[k], "expected a node number (I10), found '" + std::string(rtrim(b.lines[k])) + "'");
-    const int node_line = b.line_no[k];
-    ++k;
-    k = read_values(c, b, k, static_cast<std::size_t>(per_node), 10, "node " + std::to_string(node), &vals, node_line);
-    d.nodes.push_back(node);
-  }
+  read_node_values(c, b, 8, static_cast<std::size_t>(per_node), 9, true, &d.nodes, &vals);
   if (!b.closed) c.fail(record_name(10), b.last_line, "the file ends without the closing -1 line (truncated?)");
-  const auto nn = static_cast<Eigen::Index>(d.nodes.size());
-  d.values.resize(nn, d.values_per_node);
-  for (Eigen::Index i = 0; i < nn; ++i)
-    for (int j = 0; j < d.values_per_node; ++j) {
-      const std::size_t at = static_cast<std::size_t>(i * per_node) + (d.complex ? 2 * j : j);
-      d.values(i, j) = std::complex<double>(vals[at], d.complex ? vals[at + 1] : 0.0);
-    }
+  d.values = node_values(vals, static_cast<Eigen::Index>(d.nodes.size()), d.values_per_node, d.complex);
   return d;
 }
 
@@ -587,27 +600,9 @@ Uff2414 read2414(const Ctx& c, const Block& b, std::vector<std::string>* notes) 
   }
   const std::size_t per_node = static_cast<std::size_t>(d.values_per_node) * (d.complex() ? 2 : 1);
   std::vector<double> vals;
-  std::size_t k = 13;
-  while (k < b.lines.size()) {
-    if (trim(b.lines[k]).empty()) {
-      ++k;
-      continue;
-    }
-    int node = 0;
-    if (!parse_int(b.lines[k], &node))
-      c.fail(record_name(14), b.line_no[k], "expected a node number (I10), found '" + std::string(rtrim(b.lines[k])) + "'");
-    ++k;
-    k = read_values(c, b, k, per_node, 15, "node " + std::to_string(node), &vals);
-    d.nodes.push_back(node);
-  }
+  read_node_values(c, b, 13, per_node, 14, false, &d.nodes, &vals);
   require_closed(c, b, record_name(15));
-  const auto nn = static_cast<Eigen::Index>(d.nodes.size());
-  d.values.resize(nn, d.values_per_node);
-  for (Eigen::Index i = 0; i < nn; ++i)
-    for (int j = 0; j < d.values_per_node; ++j) {
-      const std::size_t at = static_cast<std::size_t>(i) * per_node + static_cast<std::size_t>(d.complex() ? 2 * j : j);
-      d.values(i, j) = std::complex<double>(vals[at], d.complex() ? vals[at + 1] : 0.0);
-    }
+  d.values = node_values(vals, static_cast<Eigen::Index>(d.nodes.size()), d.values_per_node, d.complex());
   return d;
 }
 
