@@ -1,7 +1,6 @@
 #include "dynid/engine/detect.hpp"
 
 #include <Eigen/Dense>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -199,8 +198,12 @@ std::vector<int> candidate_elements(const Model& model, const DetectOptions& o) 
 // The state detect() passes between its stages; each stage is a member function, in the order detect() calls them.
 class DetectRun {
  public:
-  DetectRun(const Model& model, const ModalData& changed_in, const DetectOptions& o, const ModalData* reference_measured)
-      : model(model), o(o), reference_measured(reference_measured), changed(changed_in),
+  DetectRun(const Model& model, const ModalData& changed_in, const DetectOptions& o,
+            const ModalData* reference_measured)
+      : model(model),
+        o(o),
+        reference_measured(reference_measured),
+        changed(changed_in),
         refmeas(reference_measured ? *reference_measured : ModalData{}) {}
 
   void order_measured_rows();
@@ -216,19 +219,19 @@ class DetectRun {
   const DetectOptions& o;
   const ModalData* reference_measured;
   DetectSummary S;
-  int n = 0;                       // model DOFs
-  std::vector<int> rows;           // equations of the measured DOFs
-  ModalData changed, refmeas;      // the data, rows in equation order when full_dofs
-  std::vector<int> cand;           // candidate element indices
-  int a = 0, m_serep = 0;          // measured DOFs, SEREP modes
-  ModalResult ref;                 // the reference model's modes
-  std::vector<int> translations;   // translational equations
-  Paired pc;                       // changed-state modes paired with the model
-  int p = 0;                       // modes used
-  Eigen::VectorXd lam_c;           // their eigenvalues
-  AssembledSystem sys;             // full DOFs: K0, M0
-  SerepReduction red;              // reduced DOFs: SEREP model
-  Eigen::MatrixXd Uc;              // scaled changed-state shapes
+  int n = 0;                           // model DOFs
+  std::vector<int> rows;               // equations of the measured DOFs
+  ModalData changed, refmeas;          // the data, rows in equation order when full_dofs
+  std::vector<int> cand;               // candidate element indices
+  int a = 0, m_serep = 0;              // measured DOFs, SEREP modes
+  ModalResult ref;                     // the reference model's modes
+  std::vector<int> translations;       // translational equations
+  Paired pc;                           // changed-state modes paired with the model
+  int p = 0;                           // modes used
+  Eigen::VectorXd lam_c;               // their eigenvalues
+  AssembledSystem sys;                 // full DOFs: K0, M0
+  SerepReduction red;                  // reduced DOFs: SEREP model
+  Eigen::MatrixXd Uc;                  // scaled changed-state shapes
   std::map<int, ElementScore> scores;  // by element index
   std::vector<Symmetry> syms;
   std::vector<int> flagged;
@@ -255,7 +258,8 @@ class DetectRun {
   Eigen::MatrixXd residuals_of(const Eigen::MatrixXd& U, const Eigen::VectorXd& lam) const {
     return S.full_dofs ? residual_forces(sys.K, sys.M, lam, U) : residual_forces(red.K, red.M, lam, U);
   }
-  void element_system(int e, const Eigen::MatrixXd& R, Eigen::VectorXd* y, Eigen::MatrixXd* A, std::vector<int>* rr) const;
+  void element_system(int e, const Eigen::MatrixXd& R, Eigen::VectorXd* y, Eigen::MatrixXd* A,
+                      std::vector<int>* rr) const;
   std::vector<int> residual_support(double total);
   Eigen::MatrixXd joint_refit(const std::vector<int>& sel) const;
   void confirm_greedily(const ModalData& used, const FitOptions& fo, Linearization L, double thr, double best_chi2);
@@ -435,7 +439,8 @@ void DetectRun::element_system(int e, const Eigen::MatrixXd& R, Eigen::VectorXd*
   A->resize(nl * p, 2);
   for (int i = 0; i < p; ++i) {
     Eigen::VectorXd ph(static_cast<Eigen::Index>(dofs.size()));
-    for (std::size_t q = 0; q < dofs.size(); ++q) ph[static_cast<Eigen::Index>(q)] = dofs[q] >= 0 ? Uc(dofs[q], i) : 0.0;
+    for (std::size_t q = 0; q < dofs.size(); ++q)
+      ph[static_cast<Eigen::Index>(q)] = dofs[q] >= 0 ? Uc(dofs[q], i) : 0.0;
     const Eigen::VectorXd kp = Ke * ph, mp = Me * ph;
     for (Eigen::Index l = 0; l < nl; ++l) {
       (*y)[i * nl + l] = R((*rr)[l], i);
@@ -501,8 +506,9 @@ Eigen::MatrixXd DetectRun::joint_refit(const std::vector<int>& sel) const {
 // dm_e M_e) phi_i. Each element's share is a least-squares fit on its own DOFs; elements are taken greedily.
 void DetectRun::localize_full_dofs() {
   S.method = "residual-force element fit (full DOFs)";
-  S.threshold_rule = "an element is flagged while it explains at least 1 % of the residual-force energy still "
-                     "unexplained, and that energy is above 1e-12 of the total (rounding level)";
+  S.threshold_rule =
+      "an element is flagged while it explains at least 1 % of the residual-force energy still "
+      "unexplained, and that energy is above 1e-12 of the total (rounding level)";
   const double total = S.residuals.squaredNorm();
   const std::vector<int> support = residual_support(total);
   // Single-element explained energy (the ranking).
@@ -548,10 +554,12 @@ void DetectRun::localize_full_dofs() {
 void DetectRun::localize_by_sensitivity() {
   S.method = "whitened sensitivity fit of frequencies and shapes (measured DOFs)";
   const double thr = chi2_2dof(o.significance);
-  S.threshold_rule = "an element is flagged when fitting it (dk, dm) lowers the chi-square of the frequencies and "
-                     "shapes by more than " + fmt(thr, 4) + " (chi-square quantile, 2 dof, level " +
-                     fmt(o.significance, 3) + "), with the stated noise: frequencies " + fmt(100 * o.frequency_noise, 3) +
-                     " %, shapes " + fmt(100 * o.shape_noise, 3) + " % of each mode's largest entry";
+  S.threshold_rule =
+      "an element is flagged when fitting it (dk, dm) lowers the chi-square of the frequencies and "
+      "shapes by more than " +
+      fmt(thr, 4) + " (chi-square quantile, 2 dof, level " + fmt(o.significance, 3) +
+      "), with the stated noise: frequencies " + fmt(100 * o.frequency_noise, 3) + " %, shapes " +
+      fmt(100 * o.shape_noise, 3) + " % of each mode's largest entry";
   for (int e : cand) add_params(e);
   FitOptions fo;
   fo.objective = FitObjective::kCombined;
@@ -611,9 +619,10 @@ void DetectRun::confirm_greedily(const ModalData& used, const FitOptions& fo, Li
   S.chi2_final = chi2_cur;
   theta_fit = theta;
   if (flagged.empty())
-    S.warnings.push_back("no element change is significant: the best single-element fit lowers the chi-square "
-                         "from " + fmt(S.chi2_unchanged) + " to " + fmt(best_chi2) + ", less than the threshold " +
-                         fmt(thr) + " requires");
+    S.warnings.push_back(
+        "no element change is significant: the best single-element fit lowers the chi-square "
+        "from " +
+        fmt(S.chi2_unchanged) + " to " + fmt(best_chi2) + ", less than the threshold " + fmt(thr) + " requires");
 }
 
 // Rank, flags, the 95 % confidence set and mirror twins.

@@ -102,13 +102,13 @@ struct ModalSimulator {
   explicit ModalSimulator(const VirtualTestOptions& options) : o(options) {}
   const VirtualTestOptions& o;
   double fs = 0, h = 0;
-  int n = 0;                        // samples per record
-  std::vector<int> kept;            // modes simulated (indices into the modal result)
-  std::vector<ModeMap> maps;        // their step maps
-  Eigen::VectorXd zeta;             // their damping ratios
-  Eigen::MatrixXd Ps, Pf;           // sensors x modes, force DOFs x modes
+  int n = 0;                  // samples per record
+  std::vector<int> kept;      // modes simulated (indices into the modal result)
+  std::vector<ModeMap> maps;  // their step maps
+  Eigen::VectorXd zeta;       // their damping ratios
+  Eigen::MatrixXd Ps, Pf;     // sensors x modes, force DOFs x modes
   std::vector<MeasuredDof> force_dofs;
-  Eigen::Index ns = 0;              // sensors
+  Eigen::Index ns = 0;  // sensors
 
   // Response of every sensor to forces F (samples x force DOFs).
   Eigen::MatrixXd respond(const Eigen::MatrixXd& F) const {
@@ -159,9 +159,12 @@ ModalSimulator modal_simulator(const Model& model, const ModalResult& modal, con
   std::vector<int>& kept = sim.kept;
   for (int j = 0; j < modal.modes.cols(); ++j)
     if (modal.frequencies_hz[j] < nyquist) kept.push_back(j);
-  if (kept.empty()) throw InputError("virtual test: no mode below the Nyquist frequency " + std::to_string(nyquist) + " Hz");
-  if (static_cast<int>(kept.size()) == modal.modes.cols() && modal.frequencies_hz[modal.modes.cols() - 1] < 0.8 * nyquist)
-    throw InputError("virtual test: the modal basis stops at " + std::to_string(modal.frequencies_hz[modal.modes.cols() - 1]) +
+  if (kept.empty())
+    throw InputError("virtual test: no mode below the Nyquist frequency " + std::to_string(nyquist) + " Hz");
+  if (static_cast<int>(kept.size()) == modal.modes.cols() &&
+      modal.frequencies_hz[modal.modes.cols() - 1] < 0.8 * nyquist)
+    throw InputError("virtual test: the modal basis stops at " +
+                     std::to_string(modal.frequencies_hz[modal.modes.cols() - 1]) +
                      " Hz, below the Nyquist frequency " + std::to_string(nyquist) + " Hz; compute more modes");
   const int m = static_cast<int>(kept.size());
   sim.maps.resize(static_cast<std::size_t>(m));
@@ -169,7 +172,8 @@ ModalSimulator modal_simulator(const Model& model, const ModalResult& modal, con
   for (int a = 0; a < m; ++a) {
     const double lam = modal.rigid_body[kept[a]] ? 0.0 : std::max(0.0, modal.eigenvalues[kept[a]]);
     const double w = std::sqrt(lam);
-    const double c = o.damping == VirtualTestOptions::Damping::kModal ? 2 * o.damping_ratio * w : o.rayleigh_alpha + o.rayleigh_beta * lam;
+    const double c = o.damping == VirtualTestOptions::Damping::kModal ? 2 * o.damping_ratio * w
+                                                                      : o.rayleigh_alpha + o.rayleigh_beta * lam;
     sim.zeta[a] = w > 0 ? c / (2 * w) : 0;
     sim.maps[a] = mode_map(lam, c, sim.h);
   }
@@ -198,7 +202,9 @@ void impact_recordings(const ModalSimulator& sim, double band_hi, const std::str
   const int n = sim.n;
   const double fs = sim.fs;
   const double tp = o.pulse_s > 0 ? o.pulse_s : std::max(0.75 / band_hi, 4.0 / fs);
-  if (tp * fs < 3) throw InputError("virtual test: the impact pulse (" + std::to_string(tp) + " s) spans fewer than 3 samples; raise the sampling rate");
+  if (tp * fs < 3)
+    throw InputError("virtual test: the impact pulse (" + std::to_string(tp) +
+                     " s) spans fewer than 3 samples; raise the sampling rate");
   const double t0 = o.pretrigger * o.duration_s;
   std::uint64_t record = 0;
   for (std::size_t i = 0; i < o.inputs.size(); ++i) {
@@ -225,7 +231,8 @@ void impact_recordings(const ModalSimulator& sim, double band_hi, const std::str
 }
 
 // Random-force or ambient test: one record, band-limited noise at every force DOF.
-void random_recording(const ModalSimulator& sim, double band_lo, double band_hi, const std::string& src, VirtualTest* out) {
+void random_recording(const ModalSimulator& sim, double band_lo, double band_hi, const std::string& src,
+                      VirtualTest* out) {
   const VirtualTestOptions& o = sim.o;
   const int n = sim.n;
   const Eigen::Index nf = static_cast<Eigen::Index>(sim.force_dofs.size());

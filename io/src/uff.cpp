@@ -371,8 +371,8 @@ std::size_t read_values(const Ctx& c, const Block& b, std::size_t k, std::size_t
 /// The node records of a 55 or 2414 data set from line k to the block's end: a node number (record
 /// `node_record`, I10) followed by `per_node` values (record node_record + 1; a short count is reported at the node
 /// line when `count_at_node`). Fills the node numbers and the values in file order.
-void read_node_values(const Ctx& c, const Block& b, std::size_t k, std::size_t per_node, int node_record, bool count_at_node,
-                      std::vector<int>* nodes, std::vector<double>* vals) {
+void read_node_values(const Ctx& c, const Block& b, std::size_t k, std::size_t per_node, int node_record,
+                      bool count_at_node, std::vector<int>* nodes, std::vector<double>* vals) {
   while (k < b.lines.size()) {
     if (trim(b.lines[k]).empty()) {
       ++k;
@@ -380,7 +380,8 @@ void read_node_values(const Ctx& c, const Block& b, std::size_t k, std::size_t p
     }
     int node = 0;
     if (!parse_int(b.lines[k], &node))
-      c.fail(record_name(node_record), b.line_no[k], "expected a node number (I10), found '" + std::string(rtrim(b.lines[k])) + "'");
+      c.fail(record_name(node_record), b.line_no[k],
+             "expected a node number (I10), found '" + std::string(rtrim(b.lines[k])) + "'");
     const int node_line = count_at_node ? b.line_no[k] : -1;
     ++k;
     k = read_values(c, b, k, per_node, node_record + 1, "node " + std::to_string(node), vals, node_line);

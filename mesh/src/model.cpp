@@ -164,7 +164,8 @@ void Model::finalize() {
     restrained[n] |= mask;
   }
   for (int n = 0; n < nn; ++n)
-    if (active[n] == 0 && !connected[n]) warnings_.push_back("node " + std::to_string(nodes_[n].id) + " is not connected to any element");
+    if (active[n] == 0 && !connected[n])
+      warnings_.push_back("node " + std::to_string(nodes_[n].id) + " is not connected to any element");
   dofs_ = DofMap(active, restrained);
   if (dofs_.num_free() == 0) throw InputError("the model has no free DOFs (every DOF is restrained)");
   finalized_ = true;

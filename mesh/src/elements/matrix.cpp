@@ -20,7 +20,8 @@ void check_matrices(const std::string& who, const MatrixElementData& d) {
       for (Eigen::Index i = j + 1; i < n; ++i)
         if (std::abs((*A)(i, j) - (*A)(j, i)) > 1e-12 * scale)
           throw InputError(who + ": its " + what + " matrix is not symmetric (entries " + std::to_string(i + 1) + "," +
-                           std::to_string(j + 1) + " and " + std::to_string(j + 1) + "," + std::to_string(i + 1) + " differ)");
+                           std::to_string(j + 1) + " and " + std::to_string(j + 1) + "," + std::to_string(i + 1) +
+                           " differ)");
   }
 }
 
@@ -41,7 +42,8 @@ class MatrixElement : public ElementKind {
     if (d.K.rows() != n || d.K.cols() != n || d.M.rows() != n || d.M.cols() != n)
       throw InputError(who + ": its stiffness and mass matrices must be " + std::to_string(n) + " x " +
                        std::to_string(n) + " (one row per DOF), got " + std::to_string(d.K.rows()) + " x " +
-                       std::to_string(d.K.cols()) + " and " + std::to_string(d.M.rows()) + " x " + std::to_string(d.M.cols()));
+                       std::to_string(d.K.cols()) + " and " + std::to_string(d.M.rows()) + " x " +
+                       std::to_string(d.M.cols()));
     for (double f : {e.factors.E, e.factors.rho})
       if (!finite_positive(f)) throw InputError(who + ": property factors must be finite and > 0");
     std::vector<std::pair<int, Dof>> seen;
@@ -51,7 +53,8 @@ class MatrixElement : public ElementKind {
       if (node < 0) throw InputError(who + ": node " + std::to_string(id) + " does not exist");
       for (const auto& [m, u] : seen)
         if (m == node && u == t)
-          throw InputError(who + ": DOF " + std::string(dof_name(t)) + " at node " + std::to_string(id) + " is listed twice");
+          throw InputError(who + ": DOF " + std::string(dof_name(t)) + " at node " + std::to_string(id) +
+                           " is listed twice");
       seen.emplace_back(node, t);
       (*s.active)[node] |= dof_bit(t);
     }

@@ -1,6 +1,6 @@
 // Beams and frames: what the three member kinds share (MemberKind) and the three kinds.
-//   beam2d   Euler-Bernoulli (or Timoshenko) beam along x; (uy, rz) per node; K = K_b(E Iz), M = M_t(rho A) + M_r(rho Iz).
-//   frame2d  plane frame in x-y; (ux, uy, rz) per node; K = K_a(E A) + K_b(E Iz) + K_g(P), M as beam2d plus axial.
+//   beam2d   Euler-Bernoulli (or Timoshenko) beam along x; (uy, rz) per node; K = K_b(E Iz), M = M_t(rho A) + M_r(rho
+//   Iz). frame2d  plane frame in x-y; (ux, uy, rz) per node; K = K_a(E A) + K_b(E Iz) + K_g(P), M as beam2d plus axial.
 //   frame3d  space frame; six DOFs per node; adds K_t(G J), bending about both local axes and torsional inertia.
 #include <Eigen/Dense>
 #include <cmath>
@@ -52,13 +52,17 @@ void MemberKind::setup(const ElementSetup& s) const {
   const std::string mat = who + ": material '" + m.name + "'";
   const std::string sn = who + ": section '" + sec.name + "'";
   if (!finite_positive(m.E)) throw InputError(mat + " has Young's modulus E = " + fmt_num(m.E) + "; it must be > 0");
-  if (!(std::isfinite(m.rho) && m.rho >= 0)) throw InputError(mat + " has density rho = " + fmt_num(m.rho) + "; it must be >= 0");
+  if (!(std::isfinite(m.rho) && m.rho >= 0))
+    throw InputError(mat + " has density rho = " + fmt_num(m.rho) + "; it must be >= 0");
   if (!finite_positive(sec.A)) throw InputError(sn + " has area A = " + fmt_num(sec.A) + "; it must be > 0");
-  if (!finite_positive(sec.Iz)) throw InputError(sn + " has second moment Iz = " + fmt_num(sec.Iz) + "; it must be > 0");
+  if (!finite_positive(sec.Iz))
+    throw InputError(sn + " has second moment Iz = " + fmt_num(sec.Iz) + "; it must be > 0");
   if (!(std::isfinite(sec.shear_factor) && sec.shear_factor >= 0))
-    throw InputError(sn + " has shear factor " + fmt_num(sec.shear_factor) + "; it must be >= 0 (0 = no shear deformation)");
+    throw InputError(sn + " has shear factor " + fmt_num(sec.shear_factor) +
+                     "; it must be >= 0 (0 = no shear deformation)");
   if (sec.shear_factor > 0 && !shear_modulus_known(m))
-    throw InputError(mat + ": shear deformation (section shear_factor) needs a shear modulus G or a Poisson's ratio in (-1, 0.5)");
+    throw InputError(
+        mat + ": shear deformation (section shear_factor) needs a shear modulus G or a Poisson's ratio in (-1, 0.5)");
   if (!std::isfinite(e.axial_force)) throw InputError(who + ": axial_force must be finite");
   check_geometry(s, m, sec, a, b, L);
   const DofMask d = node_dofs();
@@ -245,10 +249,13 @@ class Frame3D : public MemberKind {
   void check_geometry(const ElementSetup& s, const Material& m, const Section& sec, const Eigen::Vector3d& a,
                       const Eigen::Vector3d& b, double) const override {
     const std::string sn = s.who + ": section '" + sec.name + "'";
-    if (!finite_positive(sec.Iy)) throw InputError(sn + " has second moment Iy = " + fmt_num(sec.Iy) + "; it must be > 0");
-    if (!(std::isfinite(sec.J) && sec.J >= 0)) throw InputError(sn + " has torsion constant J = " + fmt_num(sec.J) + "; it must be >= 0");
+    if (!finite_positive(sec.Iy))
+      throw InputError(sn + " has second moment Iy = " + fmt_num(sec.Iy) + "; it must be > 0");
+    if (!(std::isfinite(sec.J) && sec.J >= 0))
+      throw InputError(sn + " has torsion constant J = " + fmt_num(sec.J) + "; it must be >= 0");
     if (!shear_modulus_known(m))
-      throw InputError(s.who + ": material '" + m.name + "': shear modulus G or a Poisson's ratio in (-1, 0.5) is needed for 3D frames");
+      throw InputError(s.who + ": material '" + m.name +
+                       "': shear modulus G or a Poisson's ratio in (-1, 0.5) is needed for 3D frames");
     Eigen::Matrix3d R;
     if (!frame3d_axes(a, b, s.element.orientation, &R))
       throw InputError(s.who + ": orientation vector is parallel to the member axis");

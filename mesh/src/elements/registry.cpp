@@ -45,7 +45,8 @@ void ElementKind::matrices(const Model& m, int e, Eigen::MatrixXd* K, Eigen::Mat
 }
 
 Eigen::MatrixXd ElementKind::unit_geometric_stiffness(const Model& m, int e) const {
-  throw InputError("element " + std::to_string(m.elements()[e].id) + ": only beams and frames have a geometric stiffness");
+  throw InputError("element " + std::to_string(m.elements()[e].id) +
+                   ": only beams and frames have a geometric stiffness");
 }
 
 Eigen::MatrixXd ElementKind::point_interpolation(const Model& m, int e, double, Eigen::MatrixXd*) const {

@@ -26,12 +26,12 @@ enum class ElementType { Beam2D, Frame2D, Frame3D, PointMass, Spring, Matrix };
 
 /// What Model::finalize() hands an element kind to check one element and activate its DOFs (first pass).
 struct ElementSetup {
-  const Model& model;             ///< nodes, materials, sections, node_index(), mass options (not finalized yet)
-  const Element& element;         ///< the element being set up
-  const std::string& who;         ///< "element 12 (frame2d)", to start error messages
-  std::array<int, 2>* nodes;      ///< out: node indices of the element's ends (-1 = none)
-  std::vector<DofMask>* active;   ///< in/out: DOF types active at each node (indexed by node index)
-  std::vector<char>* connected;   ///< out: nodes drawn by the element that need not carry its DOFs (set to 1)
+  const Model& model;            ///< nodes, materials, sections, node_index(), mass options (not finalized yet)
+  const Element& element;        ///< the element being set up
+  const std::string& who;        ///< "element 12 (frame2d)", to start error messages
+  std::array<int, 2>* nodes;     ///< out: node indices of the element's ends (-1 = none)
+  std::vector<DofMask>* active;  ///< in/out: DOF types active at each node (indexed by node index)
+  std::vector<char>* connected;  ///< out: nodes drawn by the element that need not carry its DOFs (set to 1)
 };
 
 /// The behaviour of one element type. Stateless and immutable (one shared instance per type): every method reads
