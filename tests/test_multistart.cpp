@@ -6,11 +6,14 @@
 #include <omp.h>
 
 #include <cmath>
+#include <filesystem>
 
 #include "dynid/engine/model_fit.hpp"
 #include "dynid/engine/multistart.hpp"
 #include "dynid/io/case_file.hpp"
 #include "dynid/io/modal_data_io.hpp"
+#include "dynid/solvers/cholmod.hpp"
+#include "dynid/solvers/eigen.hpp"
 #include "test_util.hpp"
 
 namespace dynid {
@@ -145,6 +148,34 @@ TEST(Multistart, SameResultForAnyThreadCountAndTheBestIsNoWorse) {
   pm.add(unbounded);
   EXPECT_HAS(test::ErrorOf([&] { fit_multistart(pm, s.measured, pm.nominal(), {}, u.options, ms); }),
              "parameter 'free' has no finite bounds");
+}
+
+// The bridge with both y support springs at 0 (their lower bound: the package's alpha = -1) is free to move in
+// y. The LL^T of K passes on rounding-level pivots, so the mechanism must be recognised by its eigenvalues: the
+// solve fails naming a DOF, as a breakdown of the factorization does. (Before, it returned 15 eigenvalues of
+// ~1e-86 (rad/s)^2, and a fit's mode search grew to 373 modes on them: 20 s per evaluation, and wrong minima.)
+TEST(Multistart, BridgeWithoutYSupportsIsAMechanism) {
+  if (!std::filesystem::is_directory(test::CasesDir() + "/../../shared/data/real/gt-pedestrian-bridge"))
+    GTEST_SKIP() << "../shared beside the source tree is missing";
+  Problem s("gt-pedestrian-bridge");
+  Eigen::VectorXd theta = s.c.update->initial;
+  for (int p = 0; p < s.pm->num_parameters(); ++p)
+    if (s.pm->parameter(p).name == "y1" || s.pm->parameter(p).name == "y2") theta[p] = 0;
+  SparseMatrix K, M;
+  s.pm->matrices(theta, &K, &M);
+  CholmodFactor F;
+  F.analyze(K);
+  ASSERT_TRUE(F.factorize(K))
+      << "the factorization itself broke down: this test no longer reaches the eigenvalue check";
+  EigenOptions eo;
+  eo.num_modes = 15;
+  const EigenSolution e = solve_eigen(K, M, eo);
+  EXPECT_EQ(e.summary.status, EigenStatus::kFactorizationFailed);
+  EXPECT_HAS(e.summary.message, "K is singular to rounding");
+  EXPECT_GE(e.summary.failed_dof, 0);
+  const EigenSolution nominal = solve_eigen(s.pm->K0(), s.pm->M0(), eo);
+  ASSERT_TRUE(nominal.summary.ok());
+  EXPECT_NEAR(std::sqrt(nominal.eigenvalues[0]) / (2 * M_PI), 4.65964, 1e-5);
 }
 
 }  // namespace
