@@ -148,6 +148,8 @@ nlohmann::json update_json(const std::string& case_name, const ParametricModel& 
     j["multistart"] = {{"starts", s.start_points.size()}, {"seed", u.search.seed}, {"continuation", u.search.continuation},
                        {"same_minimum", u.search.same_minimum}, {"failed", s.failed}, {"best_start", s.best_start},
                        {"distinct_minima", s.minima.size()}, {"minima", minima}, {"start_costs", costs},
+                       {"start_iterations", s.start_iterations}, {"start_evaluations", s.start_evaluations},
+                       {"start_seconds", s.start_time},
                        {"time_wall_s", s.time_wall}, {"time_cpu_s", s.time_cpu}};
   }
   j["warnings"] = f.warnings;
