@@ -4,7 +4,7 @@
 // local fit from the initial values, and the whole multistart search (wall and process CPU time, getrusage), with
 // its distinct minima.
 //
-//   dynid_update_bridge [--starts N] [--threads T] [--no-search] [--start K] [--case DIR]
+//   dynid_update_bridge [--starts N] [--threads T] [--no-search] [--start K] [--l-curve] [--case DIR]
 #include <omp.h>
 #include <sys/resource.h>
 
@@ -18,6 +18,7 @@
 #include "blas_kernels.hpp"
 #include "dynid/engine/model_fit.hpp"
 #include "dynid/engine/multistart.hpp"
+#include "dynid/engine/regularization.hpp"
 #include "dynid/io/case_file.hpp"
 
 using Clock = std::chrono::steady_clock;
@@ -33,7 +34,7 @@ int main(int argc, char** argv) {
   dynid::cli::ensure_blas_kernels(argv);
   std::string dir = std::string(DYNID_CASES_DIR) + "/gt-pedestrian-bridge";
   int starts = 0, threads = 0, only = -1;
-  bool search = true;
+  bool search = true, lcurve = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--starts" && i + 1 < argc)
@@ -46,9 +47,12 @@ int main(int argc, char** argv) {
       search = false;
     else if (a == "--start" && i + 1 < argc)
       only = std::atoi(argv[++i]);
+    else if (a == "--l-curve")
+      lcurve = true;
     else {
-      std::fprintf(stderr,
-                   "usage: dynid_update_bridge [--starts N] [--threads T] [--no-search] [--start K] [--case DIR]\n");
+      std::fprintf(
+          stderr,
+          "usage: dynid_update_bridge [--starts N] [--threads T] [--no-search] [--start K] [--l-curve] [--case DIR]\n");
       return 2;
     }
   }
@@ -128,6 +132,20 @@ int main(int argc, char** argv) {
     std::printf("its local fit: %.2f s wall, %.2f s CPU; %d iterations, %d evaluations, eigen %.2f s; cost %.5g\n",
                 since(t0), cpu_seconds() - c0, g.iterations, g.evaluations, g.time_eigen, g.final_cost);
     return 0;
+  }
+  if (lcurve) {  // the L-curve path, then an unregularized fit from each of its points
+    t0 = Clock::now();
+    c0 = cpu_seconds();
+    const dynid::LCurveSummary l = dynid::l_curve(pm, measured, u.initial, u.free, o);
+    std::printf("L-curve: %zu weights, %d evaluations, %.2f s wall, %.2f s CPU; corner %d (weight %.3g)\n",
+                l.points.size(), l.evaluations, since(t0), cpu_seconds() - c0, l.corner, l.weight);
+    std::printf("  weight      misfit    size     curvature  | unregularized from here: cost  max err %%  mean MAC\n");
+    for (const dynid::LCurvePoint& p : l.points) {
+      const dynid::FitSummary g = dynid::fit_parameters(pm, measured, p.theta, u.free, o);
+      std::printf("  %-10.3g  %-8.4g  %-7.4g  %9.3f  | %10.5g  %9.3f  %8.4f\n", p.weight, p.misfit, p.size, p.curvature,
+                  g.final_cost, 100 * (g.final_hz.array() / g.measured_hz.array() - 1).abs().maxCoeff(),
+                  g.final_mac.mean());
+    }
   }
   if (!search) return 0;
 
