@@ -334,7 +334,9 @@ void bind_analysis(py::module_& mod) {
       GilRelease nogil;
       run = update_case(*c, data ? &*data : nullptr);
     }
-    py::dict d = to_python(update_json(c->name, *run.pm, *c->update, run.fit, run.search ? &*run.search : nullptr)).cast<py::dict>();
+    py::dict d = to_python(update_json(c->name, *run.pm, *c->update, run.fit, run.search ? &*run.search : nullptr,
+                                       run.lcurve ? &*run.lcurve : nullptr))
+                     .cast<py::dict>();
     d["theta"] = move_array(Eigen::VectorXd(run.fit.theta));
     return d;
   });
