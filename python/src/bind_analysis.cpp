@@ -364,7 +364,8 @@ void bind_analysis(py::module_& mod) {
     {
       GilRelease nogil;
       s = discover(c->model, data.measured, c->discover->options);
-      if (c->discover->expect) check = std::make_unique<ExpectCheck>(check_expectation(*c->discover->expect, s, c->model));
+      if (c->discover->expect)
+        check = std::make_unique<ExpectCheck>(check_expectation(*c->discover->expect, s, c->model));
     }
     py::dict d = to_python(discovery_json(*c, data, s, check.get())).cast<py::dict>();
     return d;
