@@ -7,11 +7,11 @@
 #include <cmath>
 #include <set>
 
+#include "discovery/stages.hpp"
 #include "dynid/engine/candidate_checks.hpp"
 #include "dynid/engine/discovery.hpp"
 #include "dynid/engine/identify.hpp"
 #include "dynid/engine/modal.hpp"
-#include "discovery/stages.hpp"
 #include "dynid/io/discover_io.hpp"
 #include "dynid/mesh/generators.hpp"
 #include "test_util.hpp"
@@ -25,6 +25,17 @@ Material steel() {
   m.E = 2.1e11;
   m.rho = 7850;
   return m;
+}
+
+// A steel beam of 0.1 m x 0.1 m square section, `length` long.
+BeamSpec square_steel_beam(double length) {
+  BeamSpec b;
+  b.length = length;
+  b.material = steel();
+  b.section.name = "s";
+  b.section.A = 0.01;
+  b.section.Iz = 0.1 * 0.1 * 0.1 * 0.1 / 12;
+  return b;
 }
 
 Frame2DSpec portal() {
@@ -283,12 +294,7 @@ TEST(Discovery, CandidateDerivativesMatchFiniteDifferences) {
 //   P / (r^2 P_E); tolerance 0.3 %, as for the spring.
 // Before, the spring's unit was K_ii (64 times larger on the finer mesh) and the support's 4 E I / l.
 TEST(Discovery, CandidateUnitsComeFromTheBandNotTheMesh) {
-  BeamSpec b;
-  b.length = 2.0;
-  b.material = steel();
-  b.section.name = "s";
-  b.section.A = 0.01;
-  b.section.Iz = 0.1 * 0.1 * 0.1 * 0.1 / 12;
+  BeamSpec b = square_steel_beam(2.0);
   const double EI = b.material.E * b.section.Iz, L = b.length;
   const double euler = M_PI * M_PI * EI / (L * L);
   for (int elements : {8, 32}) {
@@ -438,12 +444,8 @@ namespace {
 // 1 / (1 + d_S) - 1 = (1 / 0.556 - 1) / 2, d_S = -28.5 % (the discovery benchmark's rule); the expected set
 // itself is compared with the value as given. 1e-9 relative: closed form, rounding only.
 TEST(DiscoveryExpect, DamageOverMoreElementsIsComparedByItsFlexibility) {
-  BeamSpec b;
+  BeamSpec b = square_steel_beam(1.0);
   b.elements = 8;
-  b.material = steel();
-  b.section.name = "s";
-  b.section.A = 0.01;
-  b.section.Iz = 1e-6;
   b.support = BeamSupport::Cantilever;
   const Model m = make_beam(b);
   DiscoverSpec::Expect e;

@@ -30,7 +30,7 @@ std::string kinds_words(const std::vector<std::string>& k) {
 // README). Damage in element 38 named as damage along elements 38 to 39 is one softening seen over twice the
 // length; e.value itself when the set is the expected one.
 double stiffness_reference(const DiscoverSpec::Expect& e, const Site& site, const Model& model) {
-  if (site.elements.empty() || site.elements == e.elements) return e.value;
+  if (site.elements.empty() || e.elements.empty() || site.elements == e.elements) return e.value;
   double flex = 0, total = 0;
   for (int id : site.elements) {
     const int k = model.element_index(id);

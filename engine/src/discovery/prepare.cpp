@@ -24,7 +24,8 @@ double median(std::vector<double> v) {
 void add_contamination(const ModalData& data, NoiseModel* nm) {
   const int p = data.num_modes();
   if (data.mpc.size() != p || p == 0) return;
-  Eigen::VectorXd f = nm->frequency_modes.size() == p ? nm->frequency_modes : Eigen::VectorXd::Constant(p, nm->frequency);
+  Eigen::VectorXd f =
+      nm->frequency_modes.size() == p ? nm->frequency_modes : Eigen::VectorXd::Constant(p, nm->frequency);
   bool any = false;
   for (int k = 0; k < p; ++k) {
     const double mpc = std::clamp(data.mpc[k], 0.0, 1.0);
