@@ -26,6 +26,8 @@
 //   damping error   |zeta_identified - zeta| / zeta of the found modes.
 // Seeds: dev 100000 + k (for tuning), test 200000 + k (for reporting), k = from .. from + count - 1. A block of test
 // seeds is reported once and then counts as development data: k = 0..59 (ident1, ident2), k = 60..119 (ident3).
+// ident4 fixed k = 120..179 (seeds 200120..200179, `--split test --from 120 --count 60`) before its changes and
+// tuned on the dev seeds and on the test seeds already looked at (k < 120) only.
 #include <fmt/core.h>
 
 #include <algorithm>
