@@ -67,27 +67,37 @@ Eigen::MatrixXcd lsfd(const Eigen::VectorXd& w, const Eigen::MatrixXcd& H, const
   return R;
 }
 
-// Residues of every FRF column at one pole from the lines around it alone (a local LSFD: the pole's pair and a
-// complex constant plus slope for everything else). For judging a cluster: near-duplicate poles of one mode do
-// not share (and scramble) one residue as they would in a joint fit. Returns one residue per column.
-Eigen::VectorXcd local_residues(const Eigen::VectorXd& w, const Eigen::MatrixXcd& H, std::complex<double> pole, double half_width) {
+// Residues of every FRF column at a pole from the lines around it (a local LSFD: the pole's pair, the pairs of
+// the `others` poles, and a complex constant plus slope for everything else). For judging a cluster: fitted with
+// its neighbours' poles, the two modes of a closely spaced pair each get their own residue (alone, each takes up
+// both); near-duplicate poles of one mode share its residue with parallel vectors (the split check merges them).
+// Returns the first pole's residue per column.
+Eigen::VectorXcd local_residues(const Eigen::VectorXd& w, const Eigen::MatrixXcd& H, std::complex<double> pole,
+                                const std::vector<std::complex<double>>& others, double half_width) {
   const Eigen::Index nf = w.size();
   const double wr = pole.imag();
+  const Eigen::Index np = 1 + static_cast<Eigen::Index>(others.size()), nu = 2 * np + 4;
   Eigen::Index a = std::lower_bound(w.data(), w.data() + nf, wr - half_width) - w.data();
   Eigen::Index b = std::upper_bound(w.data(), w.data() + nf, wr + half_width) - w.data();
-  while (b - a < 8 && (a > 0 || b < nf)) {
+  while (b - a < std::max<Eigen::Index>(8, nu) && (a > 0 || b < nf)) {
     if (a > 0) --a;
     if (b < nf) ++b;
   }
   const Eigen::Index n = b - a;
   const std::complex<double> I(0, 1);
-  Eigen::MatrixXcd B(n, 6);
+  Eigen::MatrixXcd B(n, nu);
   for (Eigen::Index k = 0; k < n; ++k) {
-    const std::complex<double> sk = I * w[a + k], p = 1.0 / (sk - pole), q = 1.0 / (sk - std::conj(pole));
+    const std::complex<double> sk = I * w[a + k];
+    for (Eigen::Index r = 0; r < np; ++r) {
+      const std::complex<double> pr = r == 0 ? pole : others[static_cast<std::size_t>(r - 1)];
+      const std::complex<double> p = 1.0 / (sk - pr), q = 1.0 / (sk - std::conj(pr));
+      B(k, 2 * r) = p + q;
+      B(k, 2 * r + 1) = I * p - I * q;
+    }
     const double x = (w[a + k] - wr) / std::max(half_width, 1e-300);
-    B.row(k) << p + q, I * p - I * q, 1.0, I, x, I * x;
+    B.row(k).tail(4) << 1.0, I, x, I * x;
   }
-  Eigen::MatrixXd A(2 * n, 6), rhs(2 * n, H.cols());
+  Eigen::MatrixXd A(2 * n, nu), rhs(2 * n, H.cols());
   A << B.real(), B.imag();
   rhs << H.middleRows(a, n).real(), H.middleRows(a, n).imag();
   const Eigen::VectorXd scale = A.colwise().norm().cwiseMax(1e-300).cwiseInverse();
@@ -144,6 +154,7 @@ bool IdentificationOptions::IsValid(std::string* why) const {
   if (!(cluster_damping > 0)) return fail("the cluster damping tolerance must be > 0");
   if (!(min_cluster_fraction > 0 && min_cluster_fraction <= 1)) return fail("the cluster fraction must be in (0, 1]");
   if (!(cluster_tolerance > 0 && cluster_tolerance < 0.5)) return fail("the cluster tolerance must be in (0, 0.5)");
+  if (!(cluster_mac > 0 && cluster_mac < 1)) return fail("the cluster MAC must be in (0, 1)");
   if (block_rows < 0 || decimate < 0) return fail("block rows and decimation must be >= 0");
   if (!(min_mpc >= 0 && min_mpc <= 1)) return fail("the MPC limit must be in [0, 1]");
   if (!std::isfinite(min_peak_db) || !(max_edge_db > 0)) return fail("the indicator peak limit must be finite and the edge limit > 0 dB");
@@ -390,14 +401,35 @@ Eigen::VectorXcd principal(const Eigen::MatrixXcd& Rr) {
   return svd.matrixU().col(0) * svd.singularValues()[0];
 }
 
-// A cluster's shape for the evidence checks: the principal vector of its residues from the lines around it.
-Eigen::VectorXcd lscf_cluster_shape(const LscfInput& in, const internal::PoleCluster& c, double window_decay,
-                                    double resolution_hz) {
-  const double zw = c.damping_ratio + window_decay / (2 * kPi * c.frequency_hz);
-  const std::complex<double> pw = internal::pole_of(c.frequency_hz, c.damping_ratio) - window_decay;
-  const Eigen::VectorXcd R =
-      local_residues(in.w, in.H, pw, std::max(3 * zw * std::abs(pw), 5 * 2 * kPi * resolution_hz));
-  return principal(outputs_by_inputs(R.transpose(), in.no, in.ni));
+// A cluster's shape for the evidence checks: the principal vector of its residues from the lines around it,
+// fitted together with the poles of the other clusters that get a shape (internal::kShapedShare) in that window.
+internal::ClusterShape lscf_cluster_shape(const LscfInput& in, const std::vector<internal::PoleCluster>& clusters, std::size_t c,
+                                          double window_decay, double resolution_hz, double min_share) {
+  auto windowed = [&](const internal::PoleCluster& q) {
+    return internal::pole_of(q.frequency_hz, q.damping_ratio) - window_decay;
+  };
+  const internal::PoleCluster& me = clusters[c];
+  const double zw = me.damping_ratio + window_decay / (2 * kPi * me.frequency_hz);
+  const std::complex<double> pw = windowed(me);
+  const double half_width = std::max(3 * zw * std::abs(pw), 5 * 2 * kPi * resolution_hz);
+  std::vector<std::complex<double>> others;
+  for (std::size_t q = 0; q < clusters.size(); ++q)
+    if (q != c && clusters[q].support >= min_share && std::abs(2 * kPi * clusters[q].frequency_hz - pw.imag()) <= half_width)
+      others.push_back(windowed(clusters[q]));
+  const Eigen::VectorXcd R = local_residues(in.w, in.H, pw, others, half_width);
+  internal::ClusterShape cs;
+  cs.shape = principal(outputs_by_inputs(R.transpose(), in.no, in.ni));
+  cs.strength = cs.shape.norm() / std::abs(pw.real());
+  return cs;
+}
+
+// The FRFs seen through a shape u: |u^H H|^2 / |u|^2 summed over the inputs, at every line.
+Eigen::VectorXd projected_frf_power(const FrfData& frf, const Eigen::VectorXcd& u) {
+  const int ni = frf.num_inputs(), no = frf.num_outputs();
+  const double uu = std::max(u.squaredNorm(), 1e-300);
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(frf.frequency_hz.size());
+  for (int i = 0; i < ni; ++i) out += (frf.H.middleCols(i * no, no) * u.conjugate()).cwiseAbs2();
+  return out / uu;
 }
 
 // LSFD at the modes' poles of the windowed data (the window's decay put back): shapes and contributions.
@@ -513,8 +545,8 @@ internal::OrderPoles ssi_poles(const Eigen::MatrixXd& Tm, const SsiSetup& u) {
 
 // Background and mode indicator: the first singular value of the output cross-spectral matrix (Welch, the
 // plan's resolution when given, else segments of 8 periods of the lowest frequency of interest).
-void output_spectrum_indicator(const std::vector<Eigen::MatrixXd>& records, const SsiSetup& u,
-                               const IdentificationOptions& o, IdentificationSummary& s) {
+CrossSpectra output_spectrum_indicator(const std::vector<Eigen::MatrixXd>& records, const SsiSetup& u,
+                                       const IdentificationOptions& o, IdentificationSummary& s) {
   WelchOptions wo;
   int seg = 8;
   const Eigen::Index shortest = std::min_element(records.begin(), records.end(), [](const auto& a, const auto& b) {
@@ -533,6 +565,15 @@ void output_spectrum_indicator(const std::vector<Eigen::MatrixXd>& records, cons
   for (Eigen::Index k = 0; k < G.frequency.size(); ++k)
     s.background[k] = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXcd>(G.G[k], Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
   s.background_label = "first singular value of the output spectral matrix";
+  return G;
+}
+
+// The output spectral matrix seen through a shape u: u^H G u / |u|^2 at every line.
+Eigen::VectorXd projected_spectrum(const CrossSpectra& G, const Eigen::VectorXcd& u) {
+  const double uu = std::max(u.squaredNorm(), 1e-300);
+  Eigen::VectorXd out(G.frequency.size());
+  for (Eigen::Index k = 0; k < G.frequency.size(); ++k) out[k] = std::max(u.dot(G.G[static_cast<std::size_t>(k)] * u).real(), 0.0) / uu;
+  return out;
 }
 
 // A cluster's shape: the weighted mean of its poles' shapes, each turned to the strongest member's phase.
@@ -577,7 +618,10 @@ IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationO
   // selected poles for the shapes.
   internal::select_modes(
       poles, in.lo, in.hi, o, s.background.cwiseAbs2(), decay,
-      [&](const internal::PoleCluster& c) { return lscf_cluster_shape(in, c, decay, s.resolution_hz); }, s);
+      [&](const std::vector<internal::PoleCluster>& all, std::size_t c) {
+        return lscf_cluster_shape(in, all, c, decay, s.resolution_hz, internal::kShapedShare * o.min_cluster_fraction);
+      },
+      [&](const Eigen::VectorXcd& u) { return projected_frf_power(frf_in, u); }, s);
   lscf_mode_shapes(in, decay, s);
   s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return s;
@@ -598,10 +642,13 @@ IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOpt
 
   const std::vector<Eigen::MatrixXd> records = ssi_records(rec, u);
   const internal::OrderPoles poles = ssi_poles(ssi_toeplitz(records, u), u);
-  output_spectrum_indicator(records, u, o, s);
+  const CrossSpectra G = output_spectrum_indicator(records, u, o, s);
   internal::select_modes(
       poles, u.lo, u.hi, o, s.background, 0.0,
-      [&](const internal::PoleCluster& c) { return ssi_cluster_shape(poles, c); }, s);
+      [&](const std::vector<internal::PoleCluster>& all, std::size_t c) {
+        return internal::ClusterShape{ssi_cluster_shape(poles, all[c]), -1.0};
+      },
+      [&](const Eigen::VectorXcd& shape) { return projected_spectrum(G, shape); }, s);
   for (IdentifiedMode& m : s.modes) finish_shape(m);
   mark_twins(s.modes, false);
   s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
