@@ -627,10 +627,10 @@ IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationO
   return s;
 }
 
-IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOptions& o) {
-  check_band(o);
-  const auto t0 = Clock::now();
-  rec.validate("SSI: " + rec.source);
+namespace {
+
+// SSI-cov over one band (the options' band; decimation and block rows from it).
+IdentificationSummary identify_ssi_band(const Recording& rec, const IdentificationOptions& o) {
   const SsiSetup u = ssi_setup(rec, o);
   IdentificationSummary s;
   s.method = "ssi";
@@ -639,7 +639,6 @@ IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOpt
   s.max_order = u.nmax;
   s.band_lo_hz = u.lo;
   s.band_hi_hz = u.hi;
-
   const std::vector<Eigen::MatrixXd> records = ssi_records(rec, u);
   const internal::OrderPoles poles = ssi_poles(ssi_toeplitz(records, u), u);
   const CrossSpectra G = output_spectrum_indicator(records, u, o, s);
@@ -650,6 +649,96 @@ IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOpt
       },
       [&](const Eigen::VectorXcd& shape) { return projected_spectrum(G, shape); }, s);
   for (IdentifiedMode& m : s.modes) finish_shape(m);
+  return s;
+}
+
+// Sub-bands of a wide band (identify.hpp, identify_ssi): from the top down, each [hi / kSubBandSpan, hi], owning
+// [hi / 8, hi / 2] (the top one everything above hi / 8, the lowest everything below), the next one's top a
+// quarter of this one's; the lowest reaches down to `flow`.
+constexpr double kSubBandSpan = 16;
+struct SubBand {
+  double lo = 0, hi = 0, own_lo = 0, own_hi = 0;
+};
+std::vector<SubBand> ssi_sub_bands(double flow, double hi) {
+  std::vector<SubBand> out;
+  if (hi / flow <= kSubBandSpan) return {{flow, hi, 0, 1e300}};
+  for (double top = hi;; top /= 4) {
+    SubBand b{top / kSubBandSpan, top, top / 8, out.empty() ? 1e300 : top / 2};
+    if (b.lo <= 2 * flow) {
+      b.lo = std::min(b.lo, flow);
+      b.own_lo = 0;
+      out.push_back(b);
+      break;
+    }
+    out.push_back(b);
+  }
+  return out;
+}
+
+// Adds the modes, rejected clusters and diagram poles of a sub-band's summary t in [a, b) to s.
+void merge_sub_band(IdentificationSummary& s, const IdentificationSummary& t, double a, double b) {
+  std::vector<int> index(t.modes.size(), -1);
+  for (std::size_t k = 0; k < t.modes.size(); ++k)
+    if (t.modes[k].frequency_hz >= a && t.modes[k].frequency_hz < b) {
+      index[k] = static_cast<int>(s.modes.size());
+      s.modes.push_back(t.modes[k]);
+    }
+  for (const RejectedCluster& r : t.rejected)
+    if (r.frequency_hz >= a && r.frequency_hz < b) {
+      s.rejected.push_back(r);
+      if (r.merged_into >= 0) s.rejected.back().merged_into = index[static_cast<std::size_t>(r.merged_into)];
+    }
+  for (const StabilizationPole& p : t.poles)
+    if (p.frequency_hz >= a && p.frequency_hz < b) {
+      s.poles.push_back(p);
+      if (p.cluster >= 0) s.poles.back().cluster = index[static_cast<std::size_t>(p.cluster)];
+    }
+}
+
+}  // namespace
+
+IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOptions& o) {
+  check_band(o);
+  const auto t0 = Clock::now();
+  rec.validate("SSI: " + rec.source);
+  const SsiSetup u = ssi_setup(rec, o);
+  const std::vector<SubBand> bands =
+      o.decimate == 0 && o.block_rows == 0 ? ssi_sub_bands(u.flow, u.hi) : std::vector<SubBand>{{u.lo, u.hi, 0, 1e300}};
+  IdentificationSummary s;
+  if (bands.size() == 1) {
+    s = identify_ssi_band(rec, o);
+  } else {
+    // The top sub-band's summary carries the background; every sub-band gives the modes it owns.
+    for (std::size_t k = 0; k < bands.size(); ++k) {
+      IdentificationOptions ok = o;
+      ok.band_lo_hz = bands[k].lo;
+      ok.band_hi_hz = bands[k].hi;
+      IdentificationSummary t = identify_ssi_band(rec, ok);
+      if (k == 0) {
+        s = t;
+        s.modes.clear(), s.rejected.clear(), s.poles.clear();
+        s.band_lo_hz = u.lo;
+      }
+      merge_sub_band(s, t, bands[k].own_lo, bands[k].own_hi);
+    }
+    auto by_f = [](const auto& x, const auto& y) { return x.frequency_hz < y.frequency_hz; };
+    std::vector<std::size_t> order(s.modes.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return by_f(s.modes[x], s.modes[y]); });
+    std::vector<int> rank(order.size());
+    std::vector<IdentifiedMode> modes;
+    for (std::size_t k = 0; k < order.size(); ++k) rank[order[k]] = static_cast<int>(k), modes.push_back(s.modes[order[k]]);
+    s.modes = std::move(modes);
+    for (RejectedCluster& r : s.rejected)
+      if (r.merged_into >= 0) r.merged_into = rank[static_cast<std::size_t>(r.merged_into)];
+    for (StabilizationPole& p : s.poles)
+      if (p.cluster >= 0) p.cluster = rank[static_cast<std::size_t>(p.cluster)];
+    std::stable_sort(s.rejected.begin(), s.rejected.end(), by_f);
+    char b[200];
+    std::snprintf(b, sizeof b, "SSI in %zu sub-bands (each 1:%g, decimated to its top): the band %.4g-%.4g Hz spans 1:%.0f", bands.size(),
+                  kSubBandSpan, u.flow, u.hi, u.hi / u.flow);
+    s.notes.push_back(b);
+  }
   mark_twins(s.modes, false);
   s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return s;

@@ -141,6 +141,22 @@ double excitation_top(const Spectrum& q, double top) {
   return edge;
 }
 
+// Output-only records: the highest frequency up to `top` where the outputs' spectrum, averaged over 5 lines,
+// stands >= 10 dB above its floor (the 10th percentile of its levels up to `top`): where the response ends (the
+// excitation's band, or the modes the sensors see above the noise). Highly damped modes' peaks stand less than
+// 10 dB out, so the peaks' rule stops short of them.
+double response_top(const Spectrum& q, double top) {
+  std::vector<double> levels;
+  for (Eigen::Index k = 1; k < q.level.size(); ++k)
+    if (q.f[k] <= top) levels.push_back(q.level[k]);
+  if (levels.size() < 8) return 0;
+  const double floor = 10 * percentile(levels, 0.1);
+  double edge = 0;
+  for (Eigen::Index k = 3; k + 2 < q.level.size() && q.f[k] <= top; ++k)
+    if (q.level.segment(k - 2, 5).mean() >= floor) edge = q.f[k];
+  return edge;
+}
+
 int pow2_at_most(double n) {
   int p = 8;
   while (2.0 * p <= n) p *= 2;
@@ -212,6 +228,14 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
         char b[160];
         std::snprintf(b, sizeof b,
                       "band top %.4g Hz: where the measured force's spectrum ends (10 dB below its median)", edge);
+        p.notes.push_back(b);
+      }
+    } else if (!p.impulsive && p.band_from_data) {
+      const double edge = response_top(sp, 0.45 * fs);
+      if (edge > p.band_hi_hz) {
+        p.band_hi_hz = edge;
+        char b[160];
+        std::snprintf(b, sizeof b, "band top %.4g Hz: where the outputs' spectrum ends (10 dB above its floor)", edge);
         p.notes.push_back(b);
       }
     }
