@@ -451,6 +451,76 @@ void lscf_mode_shapes(const LscfInput& in, double window_decay, IdentificationSu
   mark_twins(s.modes, true);
 }
 
+// Removes the modes marked in `drop` from s.modes, listing each in s.rejected with its reason (kSplit: merged
+// into `into`), and renumbers the diagram poles' and rejected splits' modes.
+void reject_modes(IdentificationSummary& s, const std::vector<Rejection>& why, const std::vector<char>& drop,
+                  const std::vector<double>& value, const std::vector<double>& limit, const std::vector<int>& into) {
+  std::vector<int> index(s.modes.size(), -1);
+  std::vector<IdentifiedMode> kept;
+  for (std::size_t k = 0; k < s.modes.size(); ++k)
+    if (!drop[k]) index[k] = static_cast<int>(kept.size()), kept.push_back(s.modes[k]);
+  for (RejectedCluster& r : s.rejected)
+    if (r.merged_into >= 0) r.merged_into = index[static_cast<std::size_t>(r.merged_into)];
+  for (std::size_t k = 0; k < s.modes.size(); ++k) {
+    if (!drop[k]) continue;
+    const IdentifiedMode& m = s.modes[k];
+    RejectedCluster rc;
+    rc.frequency_hz = m.frequency_hz;
+    rc.damping_ratio = m.damping_ratio;
+    rc.poles = m.poles;
+    rc.support = m.support;
+    rc.reason = why[k];
+    rc.value = value[k];
+    rc.limit = limit[k];
+    rc.merged_into = into[k] >= 0 ? index[static_cast<std::size_t>(into[k])] : -1;
+    s.rejected.push_back(rc);
+  }
+  for (StabilizationPole& p : s.poles)
+    if (p.cluster >= 0) p.cluster = index[static_cast<std::size_t>(p.cluster)];
+  std::stable_sort(s.rejected.begin(), s.rejected.end(), [](const RejectedCluster& a, const RejectedCluster& b) { return a.frequency_hz < b.frequency_hz; });
+  s.modes = std::move(kept);
+}
+
+// The modes' final shapes (LSFD at all of them together) judged as the clusters' were: a mode whose shape is not
+// a normal mode's (MPC below min_mpc) or repeats a stronger mode's (a split, by the rule of the selection, the
+// stronger by contribution) is rejected and the others are fitted again without it. The clusters' shapes were
+// local; the joint fit may hand a pole that only fits a neighbour's residual error that neighbour's shape.
+void lscf_final_modes(const LscfInput& in, const FrfData& frf_in, double window_decay, const IdentificationOptions& o,
+                      IdentificationSummary& s) {
+  for (int pass = 0; pass < 4; ++pass) {
+    lscf_mode_shapes(in, window_decay, s);
+    const std::size_t n = s.modes.size();
+    std::vector<char> drop(n, 0);
+    std::vector<Rejection> why(n, Rejection::kComplexShape);
+    std::vector<double> value(n, 0), limit(n, 0);
+    std::vector<int> into(n, -1);
+    for (std::size_t k = 0; k < n; ++k)
+      if (s.modes[k].mpc < o.min_mpc) drop[k] = 1, value[k] = s.modes[k].mpc, limit[k] = o.min_mpc;
+    std::vector<std::size_t> order;
+    for (std::size_t k = 0; k < n; ++k)
+      if (!drop[k]) order.push_back(k);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return s.modes[a].contribution > s.modes[b].contribution; });
+    auto side = [&](std::size_t k) {
+      return internal::SplitSide{s.modes[k].frequency_hz, s.modes[k].damping_ratio, s.modes[k].real_shape.cast<std::complex<double>>()};
+    };
+    for (std::size_t a = 1; a < order.size(); ++a)
+      for (std::size_t b = 0; b < a && !drop[order[a]]; ++b) {
+        const std::size_t c = order[a], h = order[b];
+        if (drop[h]) continue;
+        const Eigen::VectorXd ind = projected_frf_power(frf_in, s.modes[h].shape);
+        const double zw = s.modes[h].damping_ratio + window_decay / (2 * kPi * s.modes[h].frequency_hz);
+        const double peak = internal::indicator_evidence(s.frequency_hz, ind, s.modes[h].frequency_hz, zw).peak_db;
+        if (internal::is_split(side(c), side(h), peak, s.frequency_hz, ind, o)) {
+          drop[c] = 1, why[c] = Rejection::kSplit, into[c] = static_cast<int>(h);
+          value[c] = complex_mac(side(c).shape, side(h).shape), limit[c] = o.merge_mac;
+        }
+      }
+    if (std::find(drop.begin(), drop.end(), 1) == drop.end()) return;
+    reject_modes(s, why, drop, value, limit, into);
+  }
+  lscf_mode_shapes(in, window_decay, s);
+}
+
 // ---- SSI-cov stages -------------------------------------------------------------------------------------------
 
 struct SsiSetup {
@@ -622,7 +692,7 @@ IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationO
         return lscf_cluster_shape(in, all, c, decay, s.resolution_hz, internal::kShapedShare * o.min_cluster_fraction);
       },
       [&](const Eigen::VectorXcd& u) { return projected_frf_power(frf_in, u); }, s);
-  lscf_mode_shapes(in, decay, s);
+  lscf_final_modes(in, frf_in, decay, o, s);
   s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return s;
 }

@@ -283,6 +283,19 @@ double indicator_dip_db(const Eigen::VectorXd& f, const Eigen::VectorXd& ind, do
   return top - low;
 }
 
+bool is_split(const SplitSide& c, const SplitSide& h, double h_peak_db, const Eigen::VectorXd& frequency_hz,
+              const Eigen::VectorXd& h_indicator, const IdentificationOptions& o) {
+  const double tol = std::max(o.merge_tolerance, std::max(c.damping_ratio, h.damping_ratio));
+  const double apart = std::abs(c.frequency_hz - h.frequency_hz);
+  // Within the half-power window, or beyond it on the flank of the stronger one's indicator peak; never with a dip
+  // of the indicator between them (two peaks: two modes, whose local shapes may look alike).
+  if (apart > o.merge_span * h.frequency_hz) return false;
+  if (apart > tol * h.frequency_hz && h_peak_db < o.min_peak_db) return false;
+  const double smooth = 0.5 * std::min(c.damping_ratio * c.frequency_hz, h.damping_ratio * h.frequency_hz);
+  if (indicator_dip_db(frequency_hz, h_indicator, c.frequency_hz, h.frequency_hz, smooth) >= o.min_peak_db) return false;
+  return complex_mac(c.shape, h.shape) >= o.merge_mac;
+}
+
 namespace {
 // Support of several clusters together: per order the best weight of any of them.
 double joint_support(const std::vector<Candidate>& cands, const std::vector<std::size_t>& group, std::size_t n_orders) {
@@ -332,16 +345,9 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
     int into = -1;
     for (std::size_t g = 0; g < groups.size() && into < 0; ++g) {
       const PoleCluster& h = cands[groups[g][0]].cluster;
-      const double tol = std::max(o.merge_tolerance, std::max(c.damping_ratio, h.damping_ratio));
-      const double apart = std::abs(c.frequency_hz - h.frequency_hz);
-      // Within the half-power window, or beyond it on the flank of the stronger one's indicator peak; never with
-      // a dip of the indicator between them (two peaks: two modes, whose local shapes may look alike).
-      if (apart > o.merge_span * h.frequency_hz) continue;
-      if (apart > tol * h.frequency_hz && ev[groups[g][0]].peak_db < o.min_peak_db) continue;
-      const double smooth = 0.5 * std::min(c.damping_ratio * c.frequency_hz, h.damping_ratio * h.frequency_hz);
-      if (indicator_dip_db(s.frequency_hz, indicators[groups[g][0]], c.frequency_hz, h.frequency_hz, smooth) >= o.min_peak_db)
-        continue;
-      if (complex_mac(sk, head_shape[g]) >= o.merge_mac) into = static_cast<int>(g);
+      if (is_split({c.frequency_hz, c.damping_ratio, sk}, {h.frequency_hz, h.damping_ratio, head_shape[g]}, ev[groups[g][0]].peak_db,
+                   s.frequency_hz, indicators[groups[g][0]], o))
+        into = static_cast<int>(g);
     }
     if (into < 0) {
       groups.push_back({k});

@@ -65,6 +65,17 @@ IndicatorEvidence indicator_evidence(const Eigen::VectorXd& frequency_hz, const 
 double indicator_dip_db(const Eigen::VectorXd& frequency_hz, const Eigen::VectorXd& indicator, double fa, double fb,
                         double smooth_hz);
 
+/// The split rule (identify.hpp, step 3): a weaker mode c is a split of a stronger one h when their shapes
+/// (real-normalised) have a MAC >= merge_mac, within max(merge_tolerance, zeta) in frequency, or within merge_span
+/// with h's indicator peak standing (h_peak_db >= min_peak_db), and h's indicator nowhere dips min_peak_db between
+/// them. Damping ratios as the indicator sees them (an exponential window's decay included).
+struct SplitSide {
+  double frequency_hz = 0, damping_ratio = 0;
+  Eigen::VectorXcd shape;
+};
+bool is_split(const SplitSide& c, const SplitSide& h, double h_peak_db, const Eigen::VectorXd& frequency_hz,
+              const Eigen::VectorXd& h_indicator, const IdentificationOptions& o);
+
 /// A cluster with its shape, for the evidence checks.
 struct Candidate {
   PoleCluster cluster;
