@@ -2,9 +2,15 @@
 // ~2.5e5 DOF; for each, the 20 lowest modes by dynid, and by SciPy's eigsh and SLEPc (Krylov-Schur,
 // shift-and-invert, CHOLMOD) on the same matrices (Matrix Market), in the same run. Prints a table.
 //
-//   dynid_scaling [--quick] [--no-peers] [--only NAME] [--workdir DIR] [--peer-timeout S]
+//   dynid_scaling [--quick] [--no-peers] [--only NAME] [--workdir DIR] [--peer-timeout S] [--ranks N]
+//
+// --ranks N: instead, the distributed backend (PETSc + SLEPc + MUMPS) under `mpiexec -n N` for each model, beside
+// dynid's local solve: time, peak memory of every rank, MUMPS's factor entries, flops and memory, and the MPI traffic
+// PETSc counted (what -log_view reports; MUMPS's own messages inside the factorization are not counted there).
 //
 // Each measurement runs in its own child process so that peak memory (ru_maxrss) is that run's alone.
+#include <mpi.h>
+#include <petsclog.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -29,6 +35,7 @@
 #include "dynid/mesh/generators.hpp"
 #include "dynid/solvers/blas.hpp"
 #include "dynid/solvers/cholmod.hpp"
+#include "dynid/solvers/distributed.hpp"
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
@@ -113,6 +120,52 @@ int RunDynid(const Spec& s) {
   return 0;
 }
 
+// Child under mpiexec: the distributed backend on every rank; rank 0 prints the JSON line with every rank's peak.
+int RunDistributed(const Spec& s) {
+  dynid::start_distributed_runtime();
+  const int rank = dynid::distributed_rank(), size = dynid::distributed_size();
+  dynid::Model m = Build(s);  // every rank holds the model's description; each assembles only its rows
+  const double model_mb = PeakMb();
+  MPI_Barrier(MPI_COMM_WORLD);
+  const auto t0 = Clock::now();
+  dynid::EigenOptions o;
+  o.num_modes = 20;
+  o.method = dynid::EigenOptions::Method::kSparse;
+  o.backend = dynid::EigenOptions::Backend::kDistributed;
+  const dynid::ModalResult r = dynid::modal_analysis(m, o);
+  const double total = Since(t0);
+  const double peak = PeakMb();
+  std::vector<double> peaks(static_cast<std::size_t>(size)), models(static_cast<std::size_t>(size));
+  MPI_Gather(&peak, 1, MPI_DOUBLE, peaks.data(), 1, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  MPI_Gather(&model_mb, 1, MPI_DOUBLE, models.data(), 1, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  double traffic[4] = {petsc_send_len + petsc_isend_len, petsc_send_ct + petsc_isend_ct, petsc_allreduce_ct, 0};
+  double sum[4] = {0, 0, 0, 0};
+  MPI_Reduce(traffic, sum, 4, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
+  if (rank != 0) return 0;
+  json j = {{"dofs", r.dofs},
+            {"nnz", r.nonzeros},
+            {"ranks", size},
+            {"assembly_s", r.time_assembly},
+            {"factorize_s", r.summary.time_factorize},
+            {"lanczos_s", r.summary.time_lanczos},
+            {"total_s", total},
+            {"peak_rss_mb_per_rank", peaks},
+            {"model_rss_mb_per_rank", models},
+            {"factor_entries", r.summary.factor_nonzeros},
+            {"factor_gflop", r.summary.factor_flops / 1e9},
+            {"mumps_mb_max_rank", r.summary.factor_memory_max_mb},
+            {"mumps_mb_total", r.summary.factor_memory_total_mb},
+            {"solves", r.summary.solves},
+            {"petsc_sent_mb", sum[0] / 1048576.0},
+            {"petsc_messages", sum[1]},
+            {"petsc_allreduces", sum[2]},
+            {"status", r.ok() ? "ok" : r.summary.message},
+            {"max_residual", r.summary.max_residual},
+            {"eigenvalues", std::vector<double>(r.eigenvalues.data(), r.eigenvalues.data() + r.eigenvalues.size())}};
+  std::cout << j.dump() << std::endl;
+  return 0;
+}
+
 int ExportMatrices(const Spec& s, const std::string& dir) {
   dynid::Model m = Build(s);
   const dynid::AssembledSystem sys = dynid::assemble_system(m);
@@ -158,6 +211,39 @@ double MaxRelDiff(const json& a, const json& b) {
   return d;
 }
 
+// The distributed backend with `ranks` ranks beside dynid's local solve, one model at a time.
+int DistributedTable(const std::vector<Spec>& specs, const std::string& only, const std::string& self, int ranks) {
+  std::cout << "| model | DOF | ranks | local s | local peak MB | distributed s (factor / eigen) | peak MB per rank | "
+               "factor entries (fill vs nnz(K)) | factor GFlop | MUMPS MB max rank / total | PETSc MPI MB (messages) | "
+               "solves | max rel. diff of eigenvalues |\n"
+            << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  const std::string mpi = std::string(DYNID_MPIEXEC) + " --allow-run-as-root --oversubscribe -n " +
+                          std::to_string(ranks) + " -x OMP_NUM_THREADS=1 -x OPENBLAS_NUM_THREADS=1 ";
+  for (std::size_t k = 0; k < specs.size(); ++k) {
+    const Spec& s = specs[k];
+    if (!only.empty() && s.name.find(only) == std::string::npos) continue;
+    const json d = RunJson(self + " --child " + std::to_string(k) + " run", 3600);
+    const json p = RunJson(mpi + self + " --child " + std::to_string(k) + " mpi", 3600);
+    if (p.contains("error") || d.contains("error")) {
+      std::cout << "| " << s.name << " | local: " << d.value("error", "ok")
+                << ", distributed: " << p.value("error", "ok") << " |" << std::endl;
+      continue;
+    }
+    std::string per_rank;
+    for (const auto& v : p["peak_rss_mb_per_rank"])
+      per_rank += (per_rank.empty() ? "" : " / ") + Fmt(v.get<double>(), "%.0f");
+    const double fill = p["factor_entries"].get<double>() / p["nnz"].get<double>();
+    std::cout << "| " << s.name << " | " << p["dofs"] << " | " << ranks << " | " << Fmt(d["total_s"]) << " | "
+              << Fmt(d["peak_rss_mb"], "%.0f") << " | " << Fmt(p["total_s"]) << " (" << Fmt(p["factorize_s"]) << " / "
+              << Fmt(p["lanczos_s"]) << ") | " << per_rank << " | " << Fmt(p["factor_entries"].get<double>(), "%.3g")
+              << " (" << Fmt(fill, "%.1f") << ") | " << Fmt(p["factor_gflop"], "%.0f") << " | "
+              << p["mumps_mb_max_rank"] << " / " << p["mumps_mb_total"] << " | " << Fmt(p["petsc_sent_mb"], "%.1f")
+              << " (" << Fmt(p["petsc_messages"], "%.0f") << ") | " << p["solves"] << " | "
+              << Fmt(MaxRelDiff(d, p), "%.1e") << " |" << std::endl;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -170,10 +256,11 @@ int main(int argc, char** argv) {
       {"3D frame 20x20x20", true, 20, 20, 20, 1},
       {"3D frame 34x34x34", true, 34, 34, 34, 1},
       {"3D frame 14x14x20, div 4", true, 14, 14, 20, 4},
+      {"3D frame 54x54x54", true, 54, 54, 54, 1},  // 980,100 DOF; ~18 GB with CHOLMOD: run it alone (--only)
   };
   bool peers = true, quick = false;
   std::string only, workdir = (fs::temp_directory_path() / "dynid-scaling").string();
-  int peer_timeout = 1800;
+  int peer_timeout = 1800, ranks = 0;
   std::string self = argv[0];
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -182,13 +269,17 @@ int main(int argc, char** argv) {
     else if (a == "--only" && i + 1 < argc) only = argv[++i];
     else if (a == "--workdir" && i + 1 < argc) workdir = argv[++i];
     else if (a == "--peer-timeout" && i + 1 < argc) peer_timeout = std::atoi(argv[++i]);
+    else if (a == "--ranks" && i + 1 < argc)
+      ranks = std::atoi(argv[++i]);
     else if (a == "--child" && i + 2 < argc) {  // internal: --child INDEX run|export [dir]
       const Spec& s = specs.at(static_cast<std::size_t>(std::atoi(argv[++i])));
       const std::string what = argv[++i];
       if (what == "run") return RunDynid(s);
+      if (what == "mpi") return RunDistributed(s);
       return ExportMatrices(s, argv[++i]);
     } else {
-      std::cerr << "usage: dynid_scaling [--quick] [--no-peers] [--only NAME-SUBSTRING] [--workdir DIR] [--peer-timeout S]\n";
+      std::cerr << "usage: dynid_scaling [--quick] [--no-peers] [--only NAME-SUBSTRING] [--workdir DIR] "
+                   "[--peer-timeout S] [--ranks N]\n";
       return 2;
     }
   }
@@ -206,6 +297,7 @@ int main(int argc, char** argv) {
     std::cout << "Machine: " << model << ", " << sysconf(_SC_NPROCESSORS_ONLN) << " cores, BLAS: "
               << dynid::blas_description() << ". 20 lowest modes, shift 0, tolerance 1e-10 for all solvers.\n\n";
   }
+  if (ranks > 0) return DistributedTable(specs, only, self, ranks);
   std::cout << "| model | DOF | nnz(K) | assembly s | factorize s | eigen-solve s | total s | peak MB | solves | floor s | total/floor | SciPy s (ratio) | SciPy MB | SLEPc s (ratio) | SLEPc MB | max rel. diff of eigenvalues |\n"
             << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (std::size_t k = 0; k < specs.size(); ++k) {

@@ -36,6 +36,7 @@ int run_modal(const ModalArgs& a, const GlobalOptions& g) {
     opt.num_modes = a.modes;
     opt.band_lo = opt.band_hi = std::numeric_limits<double>::quiet_NaN();
   }
+  if (g.distributed) opt.backend = EigenOptions::Backend::kDistributed;
   Progress progress(!g.quiet);
   opt.progress = [&](std::string_view stage, double f) { progress.update(stage, f); };
   const ModalResult r = modal_analysis(c.model, opt);
@@ -58,6 +59,7 @@ int run_modal(const ModalArgs& a, const GlobalOptions& g) {
     }
     if (g.verbose) fmt::print("{}", r.summary.FullReport());
   }
+  if (!g.root) return r.ok() ? 0 : 1;  // distributed: rank 0 writes the files and reports
   if (!a.plot.empty()) refuse_existing({a.plot}, a.force);
   if (!a.view.empty()) refuse_existing({a.view}, a.force);
   if (!a.json.empty()) write_file_atomic(a.json, modal_json(c, r).dump(1) + "\n", a.force);

@@ -15,6 +15,10 @@ struct GlobalOptions {
   bool verbose = false;
   ReaderLimits limits;  ///< every file the command reads is read within these (dynid's defaults)
   int exit_code = 0;  ///< set by the subcommand that ran
+  /// Started by mpirun with several ranks: `dynid modal` solves with the distributed backend; only rank 0 prints
+  /// and writes files (`root`).
+  bool distributed = false;
+  bool root = true;
 };
 
 void set_threads(int n);

@@ -3,12 +3,16 @@
 #include <fmt/core.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
+#include <thread>
 
 #include "blas_kernels.hpp"
 #include "commands.hpp"
 #include "dynid/mesh/error.hpp"
+#include "dynid/solvers/distributed.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -41,6 +45,25 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", g.quiet, "Print only errors");
   app.add_flag("-v,--verbose", g.verbose, "Print solver details");
   register_commands(app, g);
+  if (dynid::launched_with_several_ranks()) {
+    // mpirun -n N dynid modal CASE: every rank reads the case; the eigen-solve is distributed (docs/distributed.md).
+    dynid::start_distributed_runtime();
+    g.distributed = true;
+    g.root = dynid::distributed_rank() == 0;
+    std::string command;
+    for (int i = 1; i < argc && command.empty(); ++i)
+      if (argv[i][0] != '-') command = argv[i];
+    if (command != "modal") {
+      if (g.root)
+        fmt::print(stderr, "dynid: under mpirun only `dynid modal` runs distributed; run `dynid {}` without mpirun\n",
+                   command.empty() ? "--help" : command);
+      return 2;
+    }
+    if (!g.root) g.quiet = true;
+    // The ranks on one machine share its cores (OMPI_COMM_WORLD_LOCAL_SIZE; --threads overrides).
+    if (const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE"))
+      g.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / std::max(1, std::atoi(local)));
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -21,6 +21,7 @@ packages=(
   python3-dev pybind11-dev python3-pytest python3-h5py  # the Python package (python/, docs/python.md) and its tests
   libmatio-dev zlib1g-dev  # .mat files (v5 and v7.3); the report's compressed plotly.js
   libjs-three python3-plotly  # the report's 3D mode shapes (three.js) and zoomable plots (plotly.js), embedded
+  libpetsc-real-dev libslepc-real-dev libopenmpi-dev openmpi-bin  # the distributed backend (docs/distributed.md)
 )
 
 missing=()

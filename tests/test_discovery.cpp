@@ -9,6 +9,7 @@
 
 #include "dynid/engine/candidate_checks.hpp"
 #include "dynid/engine/discovery.hpp"
+#include "dynid/engine/identify.hpp"
 #include "dynid/engine/modal.hpp"
 #include "discovery/stages.hpp"
 #include "dynid/mesh/generators.hpp"
@@ -176,6 +177,46 @@ TEST(Discovery, DataNoiseIsFlooredStatedNoiseIsKept) {
   EXPECT_EQ(t.noise.frequency, 1e-6);
   EXPECT_EQ(t.noise.shape, 1e-4);
   EXPECT_EQ(d.verdict, Verdict::kConsistent) << said(d);
+}
+
+// An identified mode with a complex shape is a mixture: its out-of-phase energy c (B/A, from MPC = ((A - B)/(A +
+// B))^2) adds sqrt(c) x the rms entry to its shape std and zeta sqrt(c) to its frequency's, in quadrature; a real
+// shape (MPC 1) keeps the noise as it was. The shape is built with a known c (in-phase a, out-of-phase b orthogonal
+// to a, |b|^2 = c |a|^2) and its MPC taken as identification takes it (modal_phase_collinearity), so the test
+// checks the inversion of the MPC too: 1e-12 relative (closed forms, rounding only).
+TEST(Discovery, ComplexShapesCarryTheirContamination) {
+  const int n = 6;
+  Eigen::VectorXd a(n), b(n);
+  a << 1.0, 0.8, -0.5, 0.3, -0.9, 0.2;
+  b << 0.3, -0.2, 0.1, 0.4, 0.0, 0.5;
+  b -= a * (a.dot(b) / a.squaredNorm());
+  const double c = 0.02;
+  b *= std::sqrt(c) * a.norm() / b.norm();
+  const Eigen::VectorXcd v = a.cast<std::complex<double>>() + std::complex<double>(0, 1) * b.cast<std::complex<double>>();
+  ModalData d;
+  for (int k = 0; k < n; ++k) d.dofs.push_back({k + 1, Dof::UX});
+  d.frequencies_hz = Eigen::Vector2d(10.0, 20.0);
+  d.shapes.resize(n, 2);
+  d.shapes.col(0) = a;
+  d.shapes.col(1) = a * 2.5;  // any scaling: the std is relative to the largest entry
+  d.damping_ratios = Eigen::Vector2d(0.01, 0.03);
+  d.mpc = Eigen::Vector2d(1.0, modal_phase_collinearity(v));
+  NoiseModel nm;
+  nm.frequency = 1e-3;
+  nm.shape = 0.02;
+  internal::add_contamination(d, &nm);
+  ASSERT_EQ(nm.frequency_modes.size(), 2);
+  ASSERT_EQ(nm.shape_modes.size(), 2);
+  EXPECT_EQ(nm.frequency_modes[0], 1e-3);
+  EXPECT_EQ(nm.shape_modes[0], 0.02);
+  const double rms = a.norm() / a.cwiseAbs().maxCoeff() / std::sqrt(double(n));
+  EXPECT_NEAR(nm.shape_modes[1], std::hypot(0.02, std::sqrt(c) * rms), 1e-12 * nm.shape_modes[1]);
+  EXPECT_NEAR(nm.frequency_modes[1], std::hypot(1e-3, 0.03 * std::sqrt(c)), 1e-12 * nm.frequency_modes[1]);
+  NoiseModel none;  // data without MPC: unchanged
+  none.frequency = 1e-3;
+  d.mpc.resize(0);
+  internal::add_contamination(d, &none);
+  EXPECT_EQ(none.frequency_modes.size(), 0);
 }
 
 }  // namespace

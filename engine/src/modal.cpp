@@ -5,6 +5,7 @@
 
 #include "dynid/engine/correlation.hpp"
 #include "dynid/mesh/generators.hpp"
+#include "dynid/solvers/distributed.hpp"
 
 namespace dynid {
 
@@ -17,20 +18,28 @@ AssembledSystem assemble_system(const ElementSource& source) {
   return s;
 }
 
-ModalResult modal_analysis(const Model& model, const EigenOptions& options) {
-  return modal_analysis(model, assemble_system(model), options);
-}
+namespace {
 
-ModalResult modal_analysis(const Model& model, const AssembledSystem& sys, const EigenOptions& options) {
+// The eigen-solve and what modal_analysis adds to it: rigid-body motions, DOF names, frequencies. `sys` null: the
+// distributed backend, where each rank assembles its own rows.
+ModalResult modal_result(const Model& model, const AssembledSystem* sys, const EigenOptions& options) {
   ModalResult r;
-  r.dofs = static_cast<int>(sys.K.rows());
-  r.nonzeros = sys.K.nonZeros();
-  r.time_assembly = sys.time_assembly;
+  r.dofs = model.num_dofs();
   EigenOptions opt = options;
   if (model.free_free() && opt.rigid_body_basis.size() == 0) {
     opt.rigid_body_basis = model.free_rigid_body_modes(&r.rigid_body_descriptions);
   }
-  EigenSolution s = solve_eigen(sys.K, sys.M, opt);
+  EigenSolution s;
+  if (sys) {
+    r.dofs = static_cast<int>(sys->K.rows());
+    r.nonzeros = sys->K.nonZeros();
+    r.time_assembly = sys->time_assembly;
+    s = solve_eigen(sys->K, sys->M, opt);
+  } else {
+    s = solve_eigen_distributed(model, opt);
+    r.time_assembly = s.summary.time_assembly;
+    r.nonzeros = s.summary.matrix_nonzeros;
+  }
   if (s.summary.failed_dof >= 0) s.summary.message += ": " + model.describe_dof(s.summary.failed_dof);
   r.summary = s.summary;
   r.eigenvalues = s.eigenvalues;
@@ -41,6 +50,17 @@ ModalResult modal_analysis(const Model& model, const AssembledSystem& sys, const
   for (Eigen::Index k = 0; k < r.eigenvalues.size(); ++k)
     r.frequencies_hz[k] = r.rigid_body[k] ? 0.0 : eigenvalue_to_hz(r.eigenvalues[k]);
   return r;
+}
+
+}  // namespace
+
+ModalResult modal_analysis(const Model& model, const EigenOptions& options) {
+  if (options.backend == EigenOptions::Backend::kDistributed) return modal_result(model, nullptr, options);
+  return modal_analysis(model, assemble_system(model), options);
+}
+
+ModalResult modal_analysis(const Model& model, const AssembledSystem& sys, const EigenOptions& options) {
+  return modal_result(model, &sys, options);
 }
 
 ModalResult lowest_modes(const Model& model, int count) {

@@ -1,19 +1,21 @@
 #include "dynid/solvers/eigen.hpp"
 
-#include <Eigen/Dense>
 #include <Spectra/SymEigsSolver.h>
-#include <stdexcept>
 #include <Spectra/SymGEigsShiftSolver.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <numeric>
 #include <random>
 #include <sstream>
+#include <stdexcept>
 
 #include "dynid/mesh/error.hpp"
 #include "dynid/solvers/cholmod.hpp"
+#include "dynid/solvers/distributed.hpp"
+#include "internal/eigen_detail.hpp"
 
 namespace dynid {
 
@@ -144,6 +146,29 @@ void normalize_signs(Eigen::MatrixXd* V) {
   }
 }
 
+void check_finite(const double* v, Eigen::Index n, const char* name) {
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (!std::isfinite(v[i])) throw InputError(std::string("eigen-solve: ") + name + " holds a NaN or Inf entry");
+}
+
+bool in_band(double lam, const EigenOptions& o) { return lam >= o.band_lo && lam <= o.band_hi; }
+bool band_mode(const EigenOptions& o) { return !std::isnan(o.band_lo); }
+
+}  // namespace
+
+namespace detail {
+
+void check_inputs(Eigen::Index kr, Eigen::Index kc, Eigen::Index mr, Eigen::Index mc, const EigenOptions& o) {
+  std::string why;
+  if (!o.IsValid(&why)) throw InputError("eigen-solve options: " + why);
+  if (kr != kc || mr != mc || kr != mr)
+    throw InputError("eigen-solve: K is " + std::to_string(kr) + "x" + std::to_string(kc) + " but M is " +
+                     std::to_string(mr) + "x" + std::to_string(mc) + "; both must be square and of the same size");
+  if (o.rigid_body_basis.size() > 0 && o.rigid_body_basis.rows() != kr)
+    throw InputError("eigen-solve: rigid-body basis has " + std::to_string(o.rigid_body_basis.rows()) +
+                     " rows, the matrices " + std::to_string(kr));
+}
+
 // M-orthonormalises the columns of B (n x r): returns Phi with Phi^T M Phi = I spanning the same space.
 Eigen::MatrixXd m_orthonormalize(const Eigen::MatrixXd& B, const Eigen::MatrixXd& MB) {
   const Eigen::MatrixXd G = B.transpose() * MB;
@@ -198,26 +223,12 @@ void finish(EigenSolution* s) {
   s->rigid_body = rig;
 }
 
-void check_inputs(Eigen::Index kr, Eigen::Index kc, Eigen::Index mr, Eigen::Index mc, const EigenOptions& o) {
-  std::string why;
-  if (!o.IsValid(&why)) throw InputError("eigen-solve options: " + why);
-  if (kr != kc || mr != mc || kr != mr)
-    throw InputError("eigen-solve: K is " + std::to_string(kr) + "x" + std::to_string(kc) + " but M is " +
-                     std::to_string(mr) + "x" + std::to_string(mc) + "; both must be square and of the same size");
-  if (o.rigid_body_basis.size() > 0 && o.rigid_body_basis.rows() != kr)
-    throw InputError("eigen-solve: rigid-body basis has " + std::to_string(o.rigid_body_basis.rows()) +
-                     " rows, the matrices " + std::to_string(kr));
-}
+}  // namespace detail
 
-void check_finite(const double* v, Eigen::Index n, const char* name) {
-  for (Eigen::Index i = 0; i < n; ++i)
-    if (!std::isfinite(v[i])) throw InputError(std::string("eigen-solve: ") + name + " holds a NaN or Inf entry");
-}
-
-bool in_band(double lam, const EigenOptions& o) { return lam >= o.band_lo && lam <= o.band_hi; }
-bool band_mode(const EigenOptions& o) { return !std::isnan(o.band_lo); }
-
-}  // namespace
+using detail::check_inputs;
+using detail::finish;
+using detail::m_orthonormalize;
+using detail::max_stiffness_to_mass;
 
 bool EigenOptions::IsValid(std::string* why) const {
   auto fail = [&](const std::string& m) {
@@ -234,6 +245,9 @@ bool EigenOptions::IsValid(std::string* why) const {
   if (subspace < 0) return fail("subspace must be >= 0");
   if (!std::isnan(shift) && !std::isfinite(shift)) return fail("shift must be finite");
   if (!(rigid_residual_tolerance > 0)) return fail("rigid_residual_tolerance must be > 0");
+  if (backend == Backend::kDistributed && lo)
+    return fail("the distributed backend solves the lowest modes only; a band needs the local backend");
+  if (!(iterative_tolerance > 0 && iterative_tolerance < 1)) return fail("iterative_tolerance must be in (0, 1)");
   return true;
 }
 
@@ -376,6 +390,7 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
   check_inputs(K.rows(), K.cols(), M.rows(), M.cols(), opt);
   check_finite(K.valuePtr(), K.nonZeros(), "K");
   check_finite(M.valuePtr(), M.nonZeros(), "M");
+  if (opt.backend == EigenOptions::Backend::kDistributed) return solve_eigen_distributed(K, M, opt);
   const Eigen::Index n = K.rows();
   const bool band = band_mode(opt);
   const Eigen::Index r = opt.rigid_body_basis.cols();

@@ -14,6 +14,7 @@ class ElementChange : public Candidate {
     return t == ElementType::Spring ? !mass : t == ElementType::PointMass ? mass : true;
   }
   std::string kind() const override { return mass_ ? "element_mass" : "element_stiffness"; }
+  std::string physics() const override { return mass_ ? "attached_mass" : "local_stiffness"; }
   Nature nature() const override { return mass_ ? Nature::kMass : Nature::kStiffness; }
   std::string description() const override {
     return std::string(mass_ ? "mass" : "stiffness") + " change of element " + std::to_string(eid_);

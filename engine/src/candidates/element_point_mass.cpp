@@ -15,6 +15,7 @@ class ElementPointMass : public Candidate {
     b_ = m.nodes()[n[1]].id;
   }
   std::string kind() const override { return "element_point_mass"; }
+  std::string physics() const override { return "attached_mass"; }
   Nature nature() const override { return Nature::kMass; }
   std::string description() const override {
     return "mass attached on element " + std::to_string(eid_) + " between nodes " + std::to_string(a_) + " and " + std::to_string(b_);

@@ -12,6 +12,7 @@ class LumpedMass : public Candidate {
   }
   bool ok() const { return !dofs_.empty(); }
   std::string kind() const override { return "lumped_mass"; }
+  std::string physics() const override { return "attached_mass"; }
   Nature nature() const override { return Nature::kMass; }
   std::string description() const override { return "lumped mass attached at node " + std::to_string(id_); }
   Site site() const override { return {{id_}, {}}; }

@@ -12,6 +12,7 @@ class MemberDamage : public Candidate {
     for (int e : els_) ids_.push_back(m.elements()[e].id);
   }
   std::string kind() const override { return "member_damage"; }
+  std::string physics() const override { return "local_stiffness"; }
   Nature nature() const override { return Nature::kStiffness; }
   std::string description() const override {
     return "stiffness change along elements " + std::to_string(ids_.front()) + " to " + std::to_string(ids_.back()) + " (" +

@@ -229,9 +229,10 @@ void weigh_rivals(const Problem& p, const Selection& sel, const std::vector<SetF
       if (std::none_of(a.begin(), a.end(), [&](const Candidate* x) { return like(x, f); })) return true;
     return false;
   };
+  // The physics a set stands for: a point mass at a node and one between the nodes of a member tell one story.
   auto kinds_of = [](const std::vector<const Candidate*>& a) {
     std::vector<std::string> k;
-    for (const Candidate* c : a) k.push_back(c->kind());
+    for (const Candidate* c : a) k.push_back(c->physics());
     std::sort(k.begin(), k.end());
     return k;
   };

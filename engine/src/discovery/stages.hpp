@@ -70,6 +70,12 @@ struct SetFit {
 // ---- prepare ----
 /// The noise model (stated, the data's own, or the conservative default with a warning).
 NoiseModel noise_model(const ModalData& data, const DiscoveryOptions& o, std::vector<std::string>* warnings);
+/// Identified modes whose shapes are complex (MPC < 1) are mixtures: a close neighbour, or a neighbour's tail, is
+/// in them. The out-of-phase part of a shape shows how much (its energy c = B/A of the in-phase part's, from MPC =
+/// ((A - B)/(A + B))^2), and the in-phase part carries as much again: each shape entry's std gains sqrt(c) times
+/// the shape's rms entry (relative to its largest), and the frequency's relative std the damping ratio times
+/// sqrt(c) (a mixture's pole moves within the half-power band), both in quadrature. Data without MPC: unchanged.
+void add_contamination(const ModalData& data, NoiseModel* nm);
 /// Free-free models: measured modes that are rigid-body motions on the test's suspension (below the first elastic
 /// model frequency, shaped like the model's rigid-body motions at the sensors).
 std::vector<SetAside> rigid_body_modes(const Model& model, const ModalData& data);

@@ -56,6 +56,19 @@ struct EigenOptions {
   enum class Method { kAuto, kSparse, kDense };
   /// kAuto: dense for n <= 300 (or when the wanted modes approach n), sparse otherwise.
   Method method = Method::kAuto;
+  /// Where the solve runs. kLocal: this process (CHOLMOD + Spectra, above). kDistributed: every rank of
+  /// MPI_COMM_WORLD together (PETSc + SLEPc: Krylov-Schur shift-and-invert on a MUMPS Cholesky factorization, or on
+  /// an iterative solve; solvers/distributed.hpp). Lowest-modes mode only (no band); dense is never used.
+  enum class Backend { kLocal, kDistributed };
+  Backend backend = Backend::kLocal;
+  /// The distributed backend's linear solve of (K - sigma M) x = b inside shift-and-invert.
+  ///  kMumpsCholesky: MUMPS's distributed L D L^T (direct; the default).
+  ///  kIterative: conjugate gradients preconditioned by algebraic multigrid (hypre BoomerAMG), each solve to the
+  ///    relative residual `iterative_tolerance`; for models whose factor does not fit the machines. The eigenvalue
+  ///    accuracy is then limited to about iterative_tolerance.
+  enum class DistributedSolver { kMumpsCholesky, kIterative };
+  DistributedSolver distributed_solver = DistributedSolver::kMumpsCholesky;
+  double iterative_tolerance = 1e-12;
   /// Progress callback (stage name, fraction in [0, 1] or -1 when unknown). Called from the calling thread.
   std::function<void(std::string_view stage, double fraction)> progress;
 
@@ -77,6 +90,11 @@ struct EigenSummary {
   int num_rigid = 0;
   double time_analyze = 0, time_factorize = 0, time_lanczos = 0;  ///< seconds
   double max_residual = 0;
+  long long matrix_nonzeros = 0;      ///< distributed backend: nonzeros of K (all ranks); the local path leaves 0
+  int ranks = 1;                      ///< MPI ranks that took part (distributed backend), else 1
+  double time_assembly = 0;           ///< distributed backend: partition + this rank's assembly (seconds)
+  double factor_memory_max_mb = 0;    ///< distributed: MUMPS's factorization memory on the largest rank (INFOG(21))
+  double factor_memory_total_mb = 0;  ///< distributed: the same summed over the ranks (INFOG(22))
   bool ok() const { return status == EigenStatus::kSuccess; }
   std::string BriefReport() const;
   std::string FullReport() const;
