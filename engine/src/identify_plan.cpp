@@ -185,10 +185,12 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
   int segment = p.impulsive ? 0 : pow2_at_most(static_cast<double>(shortest) / 8);
   if (!p.impulsive && segment < 64) segment = pow2_at_most(static_cast<double>(shortest));
   Spectrum sp = channel_spectrum(recs, p.impulsive, segment, false);
+  Spectrum hits;  // impacts: the hits' energy spectrum
   if (p.impulsive) {
     // Impacts: the outputs' energy over the hits' (a sum of |FRF|^2): the peaks of every mode the hits excite,
     // not only of those below the hits' spectral roll-off.
-    const Spectrum in = channel_spectrum(recs, true, segment, true);
+    hits = channel_spectrum(recs, true, segment, true);
+    const Spectrum& in = hits;
     if (in.level.size() == sp.level.size()) {
       const double tiny = std::max(1e-12 * in.level.maxCoeff(), 1e-300);  // lines the hits do not reach
       for (Eigen::Index k = 0; k < sp.level.size(); ++k) sp.level[k] /= std::max(in.level[k], tiny);
@@ -217,12 +219,13 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
     p.lowest_peak_hz = p.peaks_hz.front();
     p.lowest_peak_damping = widths.empty() ? 0 : widths.front() / (2 * p.lowest_peak_hz);
   }
-  // Band from the peaks, unless given; a measured broadband force shows where the excitation ends, and the top
-  // reaches it when the peaks' rule stops short of it (the highest modes' peaks stand less than 10 dB out).
+  // Band from the peaks, unless given; a measured broadband force (or the hits) shows where the excitation ends,
+  // and the top reaches it when the peaks' rule stops short of it (the highest modes' peaks stand less than 10 dB
+  // out, or overlap).
   if (o.band_hi_hz <= 0) {
     band_from_peaks(p, 0.45 * fs);
-    if (!p.impulsive && any_input && p.band_from_data) {
-      const double edge = excitation_top(channel_spectrum(recs, false, segment, true), 0.45 * fs);
+    if (any_input && p.band_from_data) {
+      const double edge = excitation_top(p.impulsive ? hits : channel_spectrum(recs, false, segment, true), 0.45 * fs);
       if (edge > p.band_hi_hz) {
         p.band_hi_hz = edge;
         char b[160];

@@ -176,9 +176,10 @@ struct IdentificationSummary {
 /// hits' spectral roll-off show their peaks too).
 ///   band: [0.5 x lowest peak, min(1.25 x highest peak, 0.45 x sampling rate)], over the peaks that stand
 ///         >= 10 dB above their surroundings (prominence) and >= 10 dB above the spectrum's 10th-percentile
-///         level (the noise floor); the whole range below 0.45 fs when there is none. Continuous records with a
-///         measured force: the top reaches where the force's spectrum ends (the highest line within 10 dB of its
-///         median level), when the peaks' rule stops below it (the highest modes' peaks stand out less).
+///         level (the noise floor); the whole range below 0.45 fs when there is none. Records with a measured
+///         force (continuous or hits): the top reaches where the force's spectrum ends (the highest line within
+///         10 dB of its median level), when the peaks' rule stops below it (the highest modes' peaks stand out
+///         less, or overlap).
 ///   resolution (continuous records): the lowest peak's half-power bandwidth 2 zeta f (zeta from the -3 dB
 ///         width, refined with longer segments while the width spans fewer than 4 lines) spans 4 lines:
 ///         segment = fs / (zeta f / 2), a power of two, at most a quarter of the shortest record (>= 7
