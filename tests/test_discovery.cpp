@@ -7,11 +7,11 @@
 #include <cmath>
 #include <set>
 
+#include "discovery/stages.hpp"
 #include "dynid/engine/candidate_checks.hpp"
 #include "dynid/engine/discovery.hpp"
 #include "dynid/engine/identify.hpp"
 #include "dynid/engine/modal.hpp"
-#include "discovery/stages.hpp"
 #include "dynid/mesh/generators.hpp"
 #include "test_util.hpp"
 

@@ -303,9 +303,11 @@ Score score(const Case& c, const ModalData& truth, const std::vector<double>& sn
       // The nearest other truth mode (a closely spaced pair when within a few per cent).
       double pair = 1e9;
       for (int q = 0; q < nt; ++q)
-        if (q != t && std::abs(truth.frequencies_hz[q] / ft - 1) < std::abs(pair)) pair = truth.frequencies_hz[q] / ft - 1;
-      sc.missed.push_back(fmt::format("{:.4g} Hz (snr {:.0f} dB; nearest {:+.2f} %, MAC {:.2f}; next truth {:+.1f} %{})", ft,
-                                      10 * std::log10(snr[static_cast<std::size_t>(t)]), nr ? 100 * best : 0.0, bm, 100 * pair, why));
+        if (q != t && std::abs(truth.frequencies_hz[q] / ft - 1) < std::abs(pair))
+          pair = truth.frequencies_hz[q] / ft - 1;
+      sc.missed.push_back(
+          fmt::format("{:.4g} Hz (snr {:.0f} dB; nearest {:+.2f} %, MAC {:.2f}; next truth {:+.1f} %{})", ft,
+                      10 * std::log10(snr[static_cast<std::size_t>(t)]), nr ? 100 * best : 0.0, bm, 100 * pair, why));
     }
   }
   const auto [true_r, true_t] = match(0.02, 0.8, false);

@@ -403,8 +403,8 @@ Eigen::VectorXcd principal(const Eigen::MatrixXcd& Rr) {
 
 // A cluster's shape for the evidence checks: the principal vector of its residues from the lines around it,
 // fitted together with the poles of the other clusters that get a shape (internal::kShapedShare) in that window.
-internal::ClusterShape lscf_cluster_shape(const LscfInput& in, const std::vector<internal::PoleCluster>& clusters, std::size_t c,
-                                          double window_decay, double resolution_hz, double min_share) {
+internal::ClusterShape lscf_cluster_shape(const LscfInput& in, const std::vector<internal::PoleCluster>& clusters,
+                                          std::size_t c, double window_decay, double resolution_hz, double min_share) {
   auto windowed = [&](const internal::PoleCluster& q) {
     return internal::pole_of(q.frequency_hz, q.damping_ratio) - window_decay;
   };
@@ -414,7 +414,8 @@ internal::ClusterShape lscf_cluster_shape(const LscfInput& in, const std::vector
   const double half_width = std::max(3 * zw * std::abs(pw), 5 * 2 * kPi * resolution_hz);
   std::vector<std::complex<double>> others;
   for (std::size_t q = 0; q < clusters.size(); ++q)
-    if (q != c && clusters[q].support >= min_share && std::abs(2 * kPi * clusters[q].frequency_hz - pw.imag()) <= half_width)
+    if (q != c && clusters[q].support >= min_share &&
+        std::abs(2 * kPi * clusters[q].frequency_hz - pw.imag()) <= half_width)
       others.push_back(windowed(clusters[q]));
   const Eigen::VectorXcd R = local_residues(in.w, in.H, pw, others, half_width);
   internal::ClusterShape cs;
@@ -477,7 +478,8 @@ void reject_modes(IdentificationSummary& s, const std::vector<Rejection>& why, c
   }
   for (StabilizationPole& p : s.poles)
     if (p.cluster >= 0) p.cluster = index[static_cast<std::size_t>(p.cluster)];
-  std::stable_sort(s.rejected.begin(), s.rejected.end(), [](const RejectedCluster& a, const RejectedCluster& b) { return a.frequency_hz < b.frequency_hz; });
+  std::stable_sort(s.rejected.begin(), s.rejected.end(),
+                   [](const RejectedCluster& a, const RejectedCluster& b) { return a.frequency_hz < b.frequency_hz; });
   s.modes = std::move(kept);
 }
 
@@ -499,9 +501,11 @@ void lscf_final_modes(const LscfInput& in, const FrfData& frf_in, double window_
     std::vector<std::size_t> order;
     for (std::size_t k = 0; k < n; ++k)
       if (!drop[k]) order.push_back(k);
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return s.modes[a].contribution > s.modes[b].contribution; });
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return s.modes[a].contribution > s.modes[b].contribution; });
     auto side = [&](std::size_t k) {
-      return internal::SplitSide{s.modes[k].frequency_hz, s.modes[k].damping_ratio, s.modes[k].real_shape.cast<std::complex<double>>()};
+      return internal::SplitSide{s.modes[k].frequency_hz, s.modes[k].damping_ratio,
+                                 s.modes[k].real_shape.cast<std::complex<double>>()};
     };
     for (std::size_t a = 1; a < order.size(); ++a)
       for (std::size_t b = 0; b < a && !drop[order[a]]; ++b) {
@@ -642,7 +646,8 @@ CrossSpectra output_spectrum_indicator(const std::vector<Eigen::MatrixXd>& recor
 Eigen::VectorXd projected_spectrum(const CrossSpectra& G, const Eigen::VectorXcd& u) {
   const double uu = std::max(u.squaredNorm(), 1e-300);
   Eigen::VectorXd out(G.frequency.size());
-  for (Eigen::Index k = 0; k < G.frequency.size(); ++k) out[k] = std::max(u.dot(G.G[static_cast<std::size_t>(k)] * u).real(), 0.0) / uu;
+  for (Eigen::Index k = 0; k < G.frequency.size(); ++k)
+    out[k] = std::max(u.dot(G.G[static_cast<std::size_t>(k)] * u).real(), 0.0) / uu;
   return out;
 }
 
@@ -794,10 +799,12 @@ IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOpt
     auto by_f = [](const auto& x, const auto& y) { return x.frequency_hz < y.frequency_hz; };
     std::vector<std::size_t> order(s.modes.size());
     for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return by_f(s.modes[x], s.modes[y]); });
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t x, std::size_t y) { return by_f(s.modes[x], s.modes[y]); });
     std::vector<int> rank(order.size());
     std::vector<IdentifiedMode> modes;
-    for (std::size_t k = 0; k < order.size(); ++k) rank[order[k]] = static_cast<int>(k), modes.push_back(s.modes[order[k]]);
+    for (std::size_t k = 0; k < order.size(); ++k)
+      rank[order[k]] = static_cast<int>(k), modes.push_back(s.modes[order[k]]);
     s.modes = std::move(modes);
     for (RejectedCluster& r : s.rejected)
       if (r.merged_into >= 0) r.merged_into = rank[static_cast<std::size_t>(r.merged_into)];
@@ -805,8 +812,9 @@ IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOpt
       if (p.cluster >= 0) p.cluster = rank[static_cast<std::size_t>(p.cluster)];
     std::stable_sort(s.rejected.begin(), s.rejected.end(), by_f);
     char b[200];
-    std::snprintf(b, sizeof b, "SSI in %zu sub-bands (each 1:%g, decimated to its top): the band %.4g-%.4g Hz spans 1:%.0f", bands.size(),
-                  kSubBandSpan, u.flow, u.hi, u.hi / u.flow);
+    std::snprintf(b, sizeof b,
+                  "SSI in %zu sub-bands (each 1:%g, decimated to its top): the band %.4g-%.4g Hz spans 1:%.0f",
+                  bands.size(), kSubBandSpan, u.flow, u.hi, u.hi / u.flow);
     s.notes.push_back(b);
   }
   mark_twins(s.modes, false);

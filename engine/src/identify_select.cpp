@@ -163,7 +163,8 @@ std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<Raw
   // pole counts.
   std::vector<std::map<int, std::pair<double, std::size_t>>> best;  // cluster -> order -> (weight, cand)
   for (std::size_t c = 0; c < nc; ++c) {
-    std::stable_sort(members[c].begin(), members[c].end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+    std::stable_sort(members[c].begin(), members[c].end(),
+                     [](const auto& x, const auto& y) { return x.first > y.first; });
     std::vector<Eigen::VectorXcd> mean;  // per family, the weighted sum of its aligned unit vectors
     const std::size_t first = best.size();
     for (const auto& [k, a] : members[c]) {
@@ -223,7 +224,8 @@ std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<Raw
     pc.damping_std = std::sqrt(vz / sw);
     out.push_back(std::move(pc));
   }
-  std::stable_sort(out.begin(), out.end(), [](const PoleCluster& x, const PoleCluster& y) { return x.frequency_hz < y.frequency_hz; });
+  std::stable_sort(out.begin(), out.end(),
+                   [](const PoleCluster& x, const PoleCluster& y) { return x.frequency_hz < y.frequency_hz; });
   return out;
 }
 
@@ -292,7 +294,8 @@ bool is_split(const SplitSide& c, const SplitSide& h, double h_peak_db, const Ei
   if (apart > o.merge_span * h.frequency_hz) return false;
   if (apart > tol * h.frequency_hz && h_peak_db < o.min_peak_db) return false;
   const double smooth = 0.5 * std::min(c.damping_ratio * c.frequency_hz, h.damping_ratio * h.frequency_hz);
-  if (indicator_dip_db(frequency_hz, h_indicator, c.frequency_hz, h.frequency_hz, smooth) >= o.min_peak_db) return false;
+  if (indicator_dip_db(frequency_hz, h_indicator, c.frequency_hz, h.frequency_hz, smooth) >= o.min_peak_db)
+    return false;
   return complex_mac(c.shape, h.shape) >= o.merge_mac;
 }
 
@@ -315,8 +318,9 @@ double joint_support(const std::vector<Candidate>& cands, const std::vector<std:
 
 std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& cands,
                                                      const std::vector<IndicatorEvidence>& ev,
-                                                     const std::vector<Eigen::VectorXd>& indicators, const IdentificationOptions& o,
-                                                     std::size_t n_orders, IdentificationSummary& s) {
+                                                     const std::vector<Eigen::VectorXd>& indicators,
+                                                     const IdentificationOptions& o, std::size_t n_orders,
+                                                     IdentificationSummary& s) {
   auto reject = [&](const PoleCluster& c, Rejection r, double value, double limit, int into = -1) {
     RejectedCluster rc;
     rc.frequency_hz = c.frequency_hz;
@@ -345,8 +349,8 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
     int into = -1;
     for (std::size_t g = 0; g < groups.size() && into < 0; ++g) {
       const PoleCluster& h = cands[groups[g][0]].cluster;
-      if (is_split({c.frequency_hz, c.damping_ratio, sk}, {h.frequency_hz, h.damping_ratio, head_shape[g]}, ev[groups[g][0]].peak_db,
-                   s.frequency_hz, indicators[groups[g][0]], o))
+      if (is_split({c.frequency_hz, c.damping_ratio, sk}, {h.frequency_hz, h.damping_ratio, head_shape[g]},
+                   ev[groups[g][0]].peak_db, s.frequency_hz, indicators[groups[g][0]], o))
         into = static_cast<int>(g);
     }
     if (into < 0) {

@@ -103,8 +103,8 @@ UpdateRun update_case(const Case& c, const ModalData* measured) {
   return run;
 }
 
-nlohmann::json update_json(const std::string& case_name, const ParametricModel& pm, const UpdateSpec& u, const FitSummary& f,
-                           const MultiStartSummary* search) {
+nlohmann::json update_json(const std::string& case_name, const ParametricModel& pm, const UpdateSpec& u,
+                           const FitSummary& f, const MultiStartSummary* search) {
   nlohmann::json params = nlohmann::json::array();
   for (int p = 0; p < pm.num_parameters(); ++p) {
     const Parameter& q = pm.parameter(p);
@@ -145,10 +145,17 @@ nlohmann::json update_json(const std::string& case_name, const ParametricModel& 
     }
     nlohmann::json costs = nlohmann::json::array();
     for (double c : s.start_cost) costs.push_back(num(std::isfinite(c) ? c : std::nan("")));
-    j["multistart"] = {{"starts", s.start_points.size()}, {"seed", u.search.seed}, {"continuation", u.search.continuation},
-                       {"same_minimum", u.search.same_minimum}, {"failed", s.failed}, {"best_start", s.best_start},
-                       {"distinct_minima", s.minima.size()}, {"minima", minima}, {"start_costs", costs},
-                       {"time_wall_s", s.time_wall}, {"time_cpu_s", s.time_cpu}};
+    j["multistart"] = {{"starts", s.start_points.size()},
+                       {"seed", u.search.seed},
+                       {"continuation", u.search.continuation},
+                       {"same_minimum", u.search.same_minimum},
+                       {"failed", s.failed},
+                       {"best_start", s.best_start},
+                       {"distinct_minima", s.minima.size()},
+                       {"minima", minima},
+                       {"start_costs", costs},
+                       {"time_wall_s", s.time_wall},
+                       {"time_cpu_s", s.time_cpu}};
   }
   j["warnings"] = f.warnings;
   return j;

@@ -93,8 +93,9 @@ struct Candidate {
 /// read on the stronger one's); `n_orders` the number of model orders.
 std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& candidates,
                                                      const std::vector<IndicatorEvidence>& evidence,
-                                                     const std::vector<Eigen::VectorXd>& indicators, const IdentificationOptions& o,
-                                                     std::size_t n_orders, IdentificationSummary& s);
+                                                     const std::vector<Eigen::VectorXd>& indicators,
+                                                     const IdentificationOptions& o, std::size_t n_orders,
+                                                     IdentificationSummary& s);
 
 /// The accepted modes as IdentifiedModes (frequency, damping, spreads and shape of the strongest cluster, the
 /// joint support of all), and the diagram's poles marked with their mode.
