@@ -1,6 +1,7 @@
 #include "dynid/io/discover_io.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <set>
 
@@ -35,11 +36,9 @@ double stiffness_reference(const DiscoverSpec::Expect& e, const Site& site, cons
   for (int id : site.elements) {
     const int k = model.element_index(id);
     if (k < 0) return e.value;
-    const Element& el = model.elements()[static_cast<std::size_t>(k)];
-    if (el.num_nodes != 2) return e.value;
-    const double L = (model.nodes()[static_cast<std::size_t>(model.node_index(el.node_ids[1]))].x -
-                      model.nodes()[static_cast<std::size_t>(model.node_index(el.node_ids[0]))].x)
-                         .norm();
+    const std::array<int, 2>& n = model.element_nodes(k);
+    if (n[0] < 0 || n[1] < 0) return e.value;
+    const double L = (model.nodes()[n[1]].x - model.nodes()[n[0]].x).norm();
     const bool hit = std::find(e.elements.begin(), e.elements.end(), id) != e.elements.end();
     flex += L * (1 / (1 + (hit ? e.value : 0.0) / 100) - 1);
     total += L;
