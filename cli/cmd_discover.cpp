@@ -86,7 +86,7 @@ int run_discover(const DiscoverArgs& a, const GlobalOptions& g) {
   progress.update("discovery", -1);
   const DiscoverySummary s = discover(c.model, d.measured, spec.options);
   std::unique_ptr<ExpectCheck> check;
-  if (spec.expect) check = std::make_unique<ExpectCheck>(check_expectation(*spec.expect, s));
+  if (spec.expect) check = std::make_unique<ExpectCheck>(check_expectation(*spec.expect, s, c.model));
   nlohmann::ordered_json j = discovery_json(c, d, s, check.get());
 
   // Robustness: the same case over further noise seeds of the truth test (seed offset 0 is the run above).
@@ -97,7 +97,7 @@ int run_discover(const DiscoverArgs& a, const GlobalOptions& g) {
     auto record = [&](int k, const DiscoverySummary& sk) {
       bool ok = false;
       if (spec.expect) {
-        const ExpectCheck ck = check_expectation(*spec.expect, sk);
+        const ExpectCheck ck = check_expectation(*spec.expect, sk, c.model);
         ok = ck.ok();
         if (std::isfinite(ck.parameter_error)) worst = std::max(worst, ck.parameter_error);
       }

@@ -44,6 +44,14 @@ int run_update(const UpdateArgs& a, const GlobalOptions& g) {
     fmt::print("dynid update: {} — {} parameters ({} free), {} measured modes at {} DOFs, objective {}\n", c.name,
                pm.num_parameters(), f.free_parameters, measured.num_modes(), measured.dofs.size(),
                fit_objective_name(u.options.objective));
+    if (run.lcurve) {
+      const LCurveSummary& l = *run.lcurve;
+      const LCurvePoint& q = l.points[static_cast<std::size_t>(l.corner)];
+      fmt::print(
+          "  regularization by the L-curve: {} weights from {:.3g} to {:.3g} ({} model evaluations); the corner, "
+          "weight {:.3g}: misfit {:.4g}, change from nominal {:.4g}\n",
+          l.points.size(), l.points.front().weight, l.points.back().weight, l.evaluations, l.weight, q.misfit, q.size);
+    }
     if (run.search) {
       const MultiStartSummary& s = *run.search;
       fmt::print("  global search: {} starts (start 0: the initial values; the others a Latin hypercube within the bounds, "
@@ -74,7 +82,12 @@ int run_update(const UpdateArgs& a, const GlobalOptions& g) {
     for (const std::string& w : f.warnings) fmt::print(stderr, "dynid update: warning: {}\n", w);
   }
   if (!a.json.empty()) {
-    write_file_atomic(a.json, update_json(c.name, pm, u, f, run.search ? &*run.search : nullptr).dump(1) + "\n", a.force);
+    write_file_atomic(
+        a.json,
+        update_json(c.name, pm, u, f, run.search ? &*run.search : nullptr, run.lcurve ? &*run.lcurve : nullptr)
+                .dump(1) +
+            "\n",
+        a.force);
     const std::string png = a.plot.empty() ? std::filesystem::path(a.json).replace_extension(".png").string() : a.plot;
     plot::save(plot::update_figure(c, pm, u, f), png, a.force);
   } else if (!a.plot.empty()) {

@@ -95,5 +95,38 @@ TEST(Assembly, RejectsNonFiniteElementMatrices) {
   }
 }
 
+// A sparse element (ElementSource::element_coupling): one element on 4 DOFs coupling only (0, 1) and (2, 3) is
+// assembled on those pairs and the diagonal (8 entries, not 16), with the dense reference's values (exact: one
+// contribution per entry); a nonzero entry outside its stated coupling is refused with the element named.
+TEST(Assembly, SparseElementsOnTheirCouplingOnly) {
+  struct Sparse : ElementSource {
+    double outside = 0;
+    int num_dofs() const override { return 4; }
+    int num_elements() const override { return 1; }
+    void element_dofs(int, std::vector<int>* d) const override { *d = {3, 2, 1, 0}; }
+    void element_matrices(int, Eigen::MatrixXd* K, Eigen::MatrixXd* M) const override {
+      Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
+      A.topLeftCorner<2, 2>() << 2, -1, -1, 3;
+      A.bottomRightCorner<2, 2>() << 4, -2, -2, 5;
+      A(0, 3) = A(3, 0) = outside;
+      if (K) *K = A;
+      if (M) *M = Eigen::Vector4d(1, 2, 3, 4).asDiagonal();
+    }
+    bool element_coupling(int, std::vector<std::pair<int, int>>* pairs) const override {
+      *pairs = {{0, 1}, {2, 3}};
+      return true;
+    }
+  } src;
+  const AssembledSystem s = assemble_system(src);
+  EXPECT_EQ(s.K.nonZeros(), 8);
+  Eigen::MatrixXd K, M;
+  DenseAssembly(src, &K, &M);
+  EXPECT_EQ(test::Dense(s.K), K);
+  EXPECT_EQ(test::Dense(s.M), M);
+  src.outside = 0.5;
+  EXPECT_HAS(test::ErrorOf([&] { assemble_system(src); }),
+             "element 0: a nonzero entry between DOFs its coupling leaves out");
+}
+
 }  // namespace
 }  // namespace dynid

@@ -481,25 +481,30 @@ class ModeCost : public ceres::CostFunction {
   int k_, first_;
 };
 
-// Tikhonov regularisation toward the nominal values: sqrt(w) (theta_p - nominal_p) / scale_p.
+// Tikhonov regularisation toward the nominal values: sqrt(w) (theta_p - nominal_p) / scale_p, at the projected
+// value as the data see it (beyond a bound: the bound, and no derivative). On the raw variable the prior would
+// pull back a variable the data push beyond its bound, a kink at the bound on which the trust region zigzags.
 class PriorCost : public ceres::CostFunction {
  public:
-  PriorCost(Eigen::VectorXd nominal, Eigen::VectorXd weight) : nominal_(std::move(nominal)), w_(std::move(weight)) {
+  PriorCost(Eigen::VectorXd nominal, Eigen::VectorXd weight, Eigen::VectorXd lower, Eigen::VectorXd upper)
+      : nominal_(std::move(nominal)), w_(std::move(weight)), lower_(std::move(lower)), upper_(std::move(upper)) {
     set_num_residuals(static_cast<int>(nominal_.size()));
     mutable_parameter_block_sizes()->push_back(static_cast<int>(nominal_.size()));
   }
   bool Evaluate(double const* const* params, double* residuals, double** jacobians) const override {
     const Eigen::Index n = nominal_.size();
-    for (Eigen::Index i = 0; i < n; ++i) residuals[i] = w_[i] * (params[0][i] - nominal_[i]);
+    for (Eigen::Index i = 0; i < n; ++i)
+      residuals[i] = w_[i] * (std::min(std::max(params[0][i], lower_[i]), upper_[i]) - nominal_[i]);
     if (jacobians && jacobians[0]) {
       std::fill(jacobians[0], jacobians[0] + n * n, 0.0);
-      for (Eigen::Index i = 0; i < n; ++i) jacobians[0][i * n + i] = w_[i];
+      for (Eigen::Index i = 0; i < n; ++i)
+        jacobians[0][i * n + i] = params[0][i] < lower_[i] || params[0][i] > upper_[i] ? 0.0 : w_[i];
     }
     return true;
   }
 
  private:
-  Eigen::VectorXd nominal_, w_;
+  Eigen::VectorXd nominal_, w_, lower_, upper_;
 };
 
 class CostRecorder : public ceres::IterationCallback {
@@ -625,12 +630,15 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
     }
   }
   if (o.regularization > 0) {
-    Eigen::VectorXd nom(nf), w(nf);
+    Eigen::VectorXd nom(nf), w(nf), lo(nf), hi(nf);
     for (int k = 0; k < nf; ++k) {
-      nom[k] = pm.parameter(free[k]).nominal;
-      w[k] = std::sqrt(o.regularization) / pm.parameter(free[k]).scale;
+      const Parameter& q = pm.parameter(free[k]);
+      nom[k] = q.nominal;
+      w[k] = std::sqrt(o.regularization) / q.scale;
+      lo[k] = q.lower;
+      hi[k] = q.upper;
     }
-    problem.AddResidualBlock(new PriorCost(nom, w), nullptr, x.data());
+    problem.AddResidualBlock(new PriorCost(nom, w, lo, hi), nullptr, x.data());
   }
   ceres::Solver::Options so;
   so.trust_region_strategy_type = o.dogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;

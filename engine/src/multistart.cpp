@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <limits>
 #include <numeric>
 
@@ -40,8 +41,9 @@ struct Rng {
 
 }  // namespace
 
-MultiStartSummary fit_multistart(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta0,
-                                 const std::vector<char>& is_free, const FitOptions& o, const MultiStartOptions& ms) {
+std::vector<Eigen::VectorXd> multistart_points(const ParametricModel& pm, const Eigen::VectorXd& theta0,
+                                               const std::vector<char>& is_free, const FitOptions& o,
+                                               const MultiStartOptions& ms) {
   std::string why;
   if (!ms.IsValid(&why)) throw InputError("multistart options: " + why);
   if (theta0.size() != pm.num_parameters())
@@ -54,8 +56,7 @@ MultiStartSummary fit_multistart(const ParametricModel& pm, const ModalData& mea
   const int n = ms.starts > 0 ? ms.starts : starts_for(static_cast<int>(free.size()));
 
   // Start 0: the user's values; starts 1..n-1: a Latin hypercube (one point per stratum in every parameter).
-  MultiStartSummary out;
-  out.start_points.assign(static_cast<std::size_t>(n), theta0);
+  std::vector<Eigen::VectorXd> points(static_cast<std::size_t>(n), theta0);
   Rng rng{ms.seed};
   const int m = n - 1;
   for (int p : free) {
@@ -67,14 +68,23 @@ MultiStartSummary fit_multistart(const ParametricModel& pm, const ModalData& mea
     for (int i = 0; i < m; ++i) {
       const double u = (perm[static_cast<std::size_t>(i)] + rng.uniform()) / m;
       const double v = log ? q.lower * std::pow(q.upper / q.lower, u) : q.lower + u * (q.upper - q.lower);
-      out.start_points[static_cast<std::size_t>(i + 1)][p] = std::min(std::max(v, q.lower), q.upper);
+      points[static_cast<std::size_t>(i + 1)][p] = std::min(std::max(v, q.lower), q.upper);
     }
   }
   for (const auto& [p, t] : o.ties)  // tied parameters follow their free partner, as in the fit
-    for (Eigen::VectorXd& x : out.start_points) {
+    for (Eigen::VectorXd& x : points) {
       const Parameter& q = pm.parameter(p);
       x[p] = std::min(std::max(t.second * x[t.first], q.lower), q.upper);
     }
+  return points;
+}
+
+MultiStartSummary fit_multistart(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta0,
+                                 const std::vector<char>& is_free, const FitOptions& o, const MultiStartOptions& ms) {
+  MultiStartSummary out;
+  out.start_points = multistart_points(pm, theta0, is_free, o, ms);
+  const std::vector<int> free = internal::free_parameters(pm, is_free, o);
+  const int n = static_cast<int>(out.start_points.size());
 
   pm.nominal();  // the parametric model's terms are built once here, not concurrently
   {
@@ -84,25 +94,38 @@ MultiStartSummary fit_multistart(const ParametricModel& pm, const ModalData& mea
   std::vector<FitSummary> fits(static_cast<std::size_t>(n));
   out.start_cost.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::infinity());
   out.start_error.assign(static_cast<std::size_t>(n), "");
+  out.start_iterations.assign(static_cast<std::size_t>(n), 0);
+  out.start_evaluations.assign(static_cast<std::size_t>(n), 0);
+  out.start_converged.assign(static_cast<std::size_t>(n), 0);
+  out.start_time.assign(static_cast<std::size_t>(n), 0.0);
   const auto t0 = std::chrono::steady_clock::now();
+  const std::clock_t clock0 = std::clock();
   internal::parallel_for(n, [&](int s) {
     const std::size_t k = static_cast<std::size_t>(s);
+    const auto ts = std::chrono::steady_clock::now();
     try {
       Eigen::VectorXd x = out.start_points[k];
       if (ms.continuation && o.objective != FitObjective::kFrequency) {
         FitOptions fo = o;
         fo.objective = FitObjective::kFrequency;
         fo.covariance = false;
-        x = fit_parameters(pm, measured, x, is_free, fo).theta;
+        const FitSummary first = fit_parameters(pm, measured, x, is_free, fo);
+        x = first.theta;
+        out.start_iterations[k] += first.iterations;
+        out.start_evaluations[k] += first.evaluations;
       }
       fits[k] = fit_parameters(pm, measured, x, is_free, o);
       out.start_cost[k] = fits[k].final_cost;
+      out.start_iterations[k] += fits[k].iterations;
+      out.start_evaluations[k] += fits[k].evaluations;
+      out.start_converged[k] = fits[k].converged;
     } catch (const NumericalError& e) {
       out.start_error[k] = e.what();
     }
+    out.start_time[k] = std::chrono::duration<double>(std::chrono::steady_clock::now() - ts).count();
   });
   out.time_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  for (const FitSummary& f : fits) out.time_cpu += f.time_total;
+  out.time_cpu = static_cast<double>(std::clock() - clock0) / CLOCKS_PER_SEC;
   out.failed = static_cast<int>(std::count_if(out.start_error.begin(), out.start_error.end(), [](const std::string& e) { return !e.empty(); }));
   if (out.failed == n) throw NumericalError("multistart: every start failed; the first: " + out.start_error[0]);
 

@@ -110,17 +110,22 @@ void ParametricModel::build() const {
   terms_.clear();
   Kfixed_ = Eigen::Map<const Eigen::VectorXd>(K0_.valuePtr(), K0_.nonZeros());
   Mfixed_ = Eigen::Map<const Eigen::VectorXd>(M0_.valuePtr(), M0_.nonZeros());
+  // The CSC position of entry (i, j), or -1 outside the pattern.
+  auto position = [&](int i, int j) {
+    const int* first = K0_.innerIndexPtr() + K0_.outerIndexPtr()[j];
+    const int* last = K0_.innerIndexPtr() + K0_.outerIndexPtr()[j + 1];
+    const int* it = std::lower_bound(first, last, i);
+    return it == last || *it != i ? -1 : static_cast<int>(it - K0_.innerIndexPtr());
+  };
   auto positions = [&](const std::vector<int>& dofs) {
     const int nd = static_cast<int>(dofs.size());
     std::vector<int> pos(static_cast<std::size_t>(nd) * nd, -1);
     for (int a = 0; a < nd; ++a)
       for (int b = 0; b < nd; ++b) {
         if (dofs[a] < 0 || dofs[b] < 0) continue;
-        const int* first = K0_.innerIndexPtr() + K0_.outerIndexPtr()[dofs[b]];
-        const int* last = K0_.innerIndexPtr() + K0_.outerIndexPtr()[dofs[b] + 1];
-        const int* it = std::lower_bound(first, last, dofs[a]);
-        if (it == last || *it != dofs[a]) throw InternalError("ParametricModel: DOF pair outside the pattern");
-        pos[static_cast<std::size_t>(a) * nd + b] = static_cast<int>(it - K0_.innerIndexPtr());
+        const int q = position(dofs[a], dofs[b]);
+        if (q < 0) throw InternalError("ParametricModel: DOF pair outside the pattern");
+        pos[static_cast<std::size_t>(a) * nd + b] = q;
       }
     return pos;
   };
@@ -128,11 +133,15 @@ void ParametricModel::build() const {
   std::map<int, std::vector<int>> by_element;
   for (int p = 0; p < num_parameters(); ++p)
     for (int e : params_[p].elements) by_element[e].push_back(p);
+  std::vector<std::pair<int, int>> coupling;
   for (const auto& [e, ps] : by_element) {
     const ElementParts parts = model_.element_parts(e);
     std::vector<int> dofs;
     model_.element_dofs(e, &dofs);
-    const std::vector<int> pos = positions(dofs);
+    // Elements assembled on their coupling (a group matrix of hundreds of DOFs, mostly zeros) keep their nonzero
+    // entries only: evaluations and sensitivities then cost their nonzeros, not the square of their DOFs.
+    const bool sparse = model_.element_coupling(e, &coupling);
+    const std::vector<int> pos = sparse ? std::vector<int>() : positions(dofs);
     struct PartDef {
       const Eigen::MatrixXd* m;
       bool mass;
@@ -162,11 +171,30 @@ void ParametricModel::build() const {
       if (t.params.empty()) continue;  // this part is not parameterised: it stays in the fixed values
       Eigen::VectorXd& fixed = t.mass ? Mfixed_ : Kfixed_;
       const int nd = static_cast<int>(dofs.size());
-      for (int a = 0; a < nd; ++a)
-        for (int b = 0; b < nd; ++b) {
-          const int q = pos[static_cast<std::size_t>(a) * nd + b];
-          if (q >= 0) fixed[q] -= t.A(a, b);
-        }
+      if (sparse) {
+        t.sparse = true;
+        for (int b = 0; b < nd; ++b)
+          for (int a = 0; a < nd; ++a) {
+            if (t.A(a, b) == 0.0 || dofs[a] < 0 || dofs[b] < 0) continue;
+            const int q = position(dofs[a], dofs[b]);
+            if (q < 0)
+              throw InternalError("ParametricModel: a nonzero entry of element " + std::to_string(e) +
+                                  " outside the pattern");
+            t.ea.push_back(a);
+            t.eb.push_back(b);
+            t.ev.push_back(t.A(a, b));
+            t.epos.push_back(q);
+            fixed[q] -= t.A(a, b);
+          }
+        t.A.resize(0, 0);
+        t.pos.clear();
+      } else {
+        for (int a = 0; a < nd; ++a)
+          for (int b = 0; b < nd; ++b) {
+            const int q = pos[static_cast<std::size_t>(a) * nd + b];
+            if (q >= 0) fixed[q] -= t.A(a, b);
+          }
+      }
       terms_.push_back(std::move(t));
     }
   }
@@ -233,6 +261,10 @@ void ParametricModel::matrices(const Eigen::VectorXd& theta, SparseMatrix* K, Sp
     if (!target) continue;
     const double s = scale(t, theta);
     double* v = target->valuePtr();
+    if (t.sparse) {
+      for (std::size_t k = 0; k < t.ev.size(); ++k) v[t.epos[k]] += s * t.ev[k];
+      continue;
+    }
     const int nd = static_cast<int>(t.dofs.size());
     for (int a = 0; a < nd; ++a)
       for (int b = 0; b < nd; ++b) {
@@ -280,6 +312,16 @@ Eigen::MatrixXd ParametricModel::eigenvalue_sensitivities(const Eigen::VectorXd&
       const Term& t = terms_[k];
       const double ds = dscale(t, p, theta);
       const int nd = static_cast<int>(t.dofs.size());
+      if (t.sparse) {
+        for (Eigen::Index i = 0; i < m; ++i) {
+          const double* phi = Phi.col(i).data();
+          double q = 0;
+          for (std::size_t e = 0; e < t.ev.size(); ++e) q += t.ev[e] * phi[t.dofs[t.ea[e]]] * phi[t.dofs[t.eb[e]]];
+          q *= ds;
+          S(i, p) += t.mass ? -lambda[i] * q : q;
+        }
+        continue;
+      }
       for (Eigen::Index i = 0; i < m; ++i) {
         pe.setZero(nd);
         for (int a = 0; a < nd; ++a)
@@ -318,7 +360,14 @@ void ParametricModel::derivative_products(int p, const Eigen::VectorXd& theta, c
     ve.setZero(nd);
     for (int a = 0; a < nd; ++a)
       if (t.dofs[a] >= 0) ve[a] = v[t.dofs[a]];
-    const Eigen::VectorXd y = ds * (t.A * ve);
+    Eigen::VectorXd y;
+    if (t.sparse) {
+      y.setZero(nd);
+      for (std::size_t e = 0; e < t.ev.size(); ++e) y[t.ea[e]] += t.ev[e] * ve[t.eb[e]];
+      y *= ds;
+    } else {
+      y = ds * (t.A * ve);
+    }
     for (int a = 0; a < nd; ++a) {
       if (t.dofs[a] < 0) continue;
       out->dof.push_back(t.dofs[a]);

@@ -1,4 +1,5 @@
 // The `update:` section of a case file (model updating). See docs/case-file.md.
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -96,7 +97,15 @@ UpdateSpec parse_update(const YAML::Node& n, const YamlCtx& ctx, const Model& mo
     if (q["frequency"]) o.frequency_noise = ctx.number(q["frequency"], "noise frequency");
     if (q["shape"]) o.shape_noise = ctx.number(q["shape"], "noise shape");
   }
-  if (n["regularization"]) o.regularization = ctx.number(n["regularization"], "regularization");
+  if (n["regularization"]) {  // a weight, or l-curve (chosen by the rule: docs/method.md)
+    const YAML::Node& q = n["regularization"];
+    if (q.IsScalar() && q.Scalar() == "l-curve")
+      u.lcurve = true;
+    else if (q.IsScalar() && !q.Scalar().empty() && std::isalpha(static_cast<unsigned char>(q.Scalar()[0])))
+      ctx.fail(q, "update: regularization must be a weight (a number >= 0) or l-curve, got '" + q.Scalar() + "'");
+    else
+      o.regularization = ctx.number(q, "regularization");
+  }
   if (n["loss"]) {
     const std::string s = ctx.string(n["loss"], "loss");
     if (s == "none") o.loss = FitOptions::Loss::kNone;

@@ -91,20 +91,27 @@ UpdateRun update_case(const Case& c, const ModalData* measured) {
                     format_number(pl.correlation.mac[k], 3) + "): set aside, not fitted");
   if (!pl.unpaired.empty()) run.measured = modes_subset(run.measured, pl.paired);
   const MeasuredNoise noise = measured_noise(run.measured, u.options);
+  FitOptions o = noise.options;
+  if (u.lcurve) {  // the weight by the L-curve rule, traced from the initial values; then the fit or search with it
+    run.lcurve = l_curve(*run.pm, run.measured, u.initial, u.free, o, u.lcurve_options);
+    o.regularization = run.lcurve->weight;
+  }
   if (u.multistart) {
-    run.search = fit_multistart(*run.pm, run.measured, u.initial, u.free, noise.options, u.search);
+    run.search = fit_multistart(*run.pm, run.measured, u.initial, u.free, o, u.search);
     run.fit = run.search->best;
     run.fit.warnings.insert(run.fit.warnings.begin(), run.search->warnings.begin(), run.search->warnings.end());
   } else {
-    run.fit = fit_parameters(*run.pm, run.measured, u.initial, u.free, noise.options);
+    run.fit = fit_parameters(*run.pm, run.measured, u.initial, u.free, o);
   }
+  if (run.lcurve)
+    run.fit.warnings.insert(run.fit.warnings.begin(), run.lcurve->warnings.begin(), run.lcurve->warnings.end());
   run.fit.warnings.insert(run.fit.warnings.begin(), noise.warnings.begin(), noise.warnings.end());
   run.fit.warnings.insert(run.fit.warnings.begin(), aside.begin(), aside.end());
   return run;
 }
 
 nlohmann::json update_json(const std::string& case_name, const ParametricModel& pm, const UpdateSpec& u,
-                           const FitSummary& f, const MultiStartSummary* search) {
+                           const FitSummary& f, const MultiStartSummary* search, const LCurveSummary* lcurve) {
   nlohmann::json params = nlohmann::json::array();
   for (int p = 0; p < pm.num_parameters(); ++p) {
     const Parameter& q = pm.parameter(p);
@@ -154,8 +161,24 @@ nlohmann::json update_json(const std::string& case_name, const ParametricModel& 
                        {"distinct_minima", s.minima.size()},
                        {"minima", minima},
                        {"start_costs", costs},
+                       {"start_iterations", s.start_iterations},
+                       {"start_evaluations", s.start_evaluations},
+                       {"start_seconds", s.start_time},
                        {"time_wall_s", s.time_wall},
                        {"time_cpu_s", s.time_cpu}};
+  }
+  if (lcurve) {
+    nlohmann::json pts = nlohmann::json::array();
+    for (const LCurvePoint& p : lcurve->points)
+      pts.push_back({{"weight", p.weight},
+                     {"misfit", p.misfit},
+                     {"size", p.size},
+                     {"curvature", p.curvature},
+                     {"converged", p.converged}});
+    j["regularization"] = {
+        {"rule", "l-curve"}, {"weight", lcurve->weight}, {"corner", lcurve->corner}, {"points", pts}};
+  } else if (u.options.regularization > 0) {
+    j["regularization"] = {{"rule", "fixed"}, {"weight", u.options.regularization}};
   }
   j["warnings"] = f.warnings;
   return j;

@@ -219,6 +219,28 @@ void Model::finalize_matrix_element(int k, std::vector<DofMask>* active) {
   }
   for (int id : d.nodes)
     if (node_index(id) < 0) throw InputError(who + ": node " + std::to_string(id) + " does not exist");
+  // Coupling node by node: the blocks of node pairs with a nonzero K or M entry between them, and every node's own
+  // block. A group matrix exported from another FE code touches hundreds of DOFs but couples few of them.
+  {
+    std::vector<int> local(nodes_.size(), -1), node_of(static_cast<std::size_t>(n));
+    int nn = 0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const int node = out[static_cast<std::size_t>(i)].first;
+      if (local[node] < 0) local[node] = nn++;
+      node_of[static_cast<std::size_t>(i)] = local[node];
+    }
+    std::vector<char> coupled(static_cast<std::size_t>(nn) * nn, 0);
+    for (Eigen::Index j = 0; j < n; ++j)
+      for (Eigen::Index i = 0; i < n; ++i)
+        if (d.K(i, j) != 0.0 || d.M(i, j) != 0.0 || node_of[i] == node_of[j])
+          coupled[static_cast<std::size_t>(node_of[i]) * nn + node_of[j]] = 1;
+    auto& pairs = matrix_coupling_[k];
+    for (int b = 1; b < n; ++b)
+      for (int a = 0; a < b; ++a)
+        if (coupled[static_cast<std::size_t>(node_of[a]) * nn + node_of[b]]) pairs.emplace_back(a, b);
+    matrix_sparse_[k] = static_cast<long long>(pairs.size()) < static_cast<long long>(n) * (n - 1) / 2;
+    if (!matrix_sparse_[k]) pairs = {};
+  }
   for (int a = 0; a < 2; ++a) {
     element_nodes_[k][a] = a < e.num_nodes ? node_index(e.node_ids[a]) : -1;
     if (a < e.num_nodes && element_nodes_[k][a] < 0)
@@ -233,6 +255,8 @@ void Model::finalize() {
   element_nodes_.assign(elements_.size(), {{-1, -1}});
   point_mass_dofs_.assign(elements_.size(), 0);
   matrix_dofs_.assign(elements_.size(), {});
+  matrix_coupling_.assign(elements_.size(), {});
+  matrix_sparse_.assign(elements_.size(), 0);
   std::vector<DofMask> active(nn, 0), restrained(nn, 0);
   std::vector<int> pm;  // point masses, resolved after DOF activation
 
@@ -626,6 +650,11 @@ void Model::element_matrices(int e, Eigen::MatrixXd* K, Eigen::MatrixXd* M) cons
   if (M) *M = p.M();
 }
 
+bool Model::element_coupling(int e, std::vector<std::pair<int, int>>* pairs) const {
+  require_finalized("element_coupling");
+  *pairs = matrix_coupling_[e];
+  return matrix_sparse_[e] != 0;
+}
 
 Eigen::MatrixXd Model::rigid_body_motions(std::vector<std::string>* labels) const {
   require_finalized("rigid_body_motions");

@@ -334,7 +334,9 @@ void bind_analysis(py::module_& mod) {
       GilRelease nogil;
       run = update_case(*c, data ? &*data : nullptr);
     }
-    py::dict d = to_python(update_json(c->name, *run.pm, *c->update, run.fit, run.search ? &*run.search : nullptr)).cast<py::dict>();
+    py::dict d = to_python(update_json(c->name, *run.pm, *c->update, run.fit, run.search ? &*run.search : nullptr,
+                                       run.lcurve ? &*run.lcurve : nullptr))
+                     .cast<py::dict>();
     d["theta"] = move_array(Eigen::VectorXd(run.fit.theta));
     return d;
   });
@@ -362,7 +364,8 @@ void bind_analysis(py::module_& mod) {
     {
       GilRelease nogil;
       s = discover(c->model, data.measured, c->discover->options);
-      if (c->discover->expect) check = std::make_unique<ExpectCheck>(check_expectation(*c->discover->expect, s));
+      if (c->discover->expect)
+        check = std::make_unique<ExpectCheck>(check_expectation(*c->discover->expect, s, c->model));
     }
     py::dict d = to_python(discovery_json(*c, data, s, check.get())).cast<py::dict>();
     return d;

@@ -35,16 +35,43 @@ Assembler::Assembler(const ElementSource& source) : src_(source), n_(source.num_
     for (int e = 0; e < ne; ++e)
       for (int k = eptr[e]; k < eptr[e + 1]; ++k) delem[fill[edofs[k]]++] = e;
   }
-  // Pattern: column j holds the DOFs of every element touching j (and the diagonal). Two passes (count, fill),
-  // each column independent, so the result does not depend on the thread count.
+  // Sparse elements (element_coupling): their coupled pairs per column (CSR), instead of all their DOFs.
+  sparse_.assign(ne, 0);
+  std::vector<int> xptr(n_ + 1, 0), xrows;
+  {
+    std::vector<std::pair<int, int>> pairs, global;
+    std::vector<int> d;
+    for (int e = 0; e < ne; ++e) {
+      if (!source.element_coupling(e, &pairs)) continue;
+      sparse_[e] = 1;
+      source.element_dofs(e, &d);
+      for (const auto& [a, b] : pairs) {
+        if (a < 0 || b < 0 || a >= static_cast<int>(d.size()) || b >= static_cast<int>(d.size()))
+          throw InputError("element " + std::to_string(e) + ": a coupled pair outside its " + std::to_string(d.size()) +
+                           " DOFs");
+        if (d[a] < 0 || d[b] < 0) continue;
+        global.emplace_back(d[a], d[b]);
+        global.emplace_back(d[b], d[a]);
+      }
+    }
+    for (const auto& [i, j] : global) ++xptr[j + 1];
+    for (int i = 0; i < n_; ++i) xptr[i + 1] += xptr[i];
+    xrows.resize(global.size());
+    std::vector<int> fill(xptr.begin(), xptr.end() - 1);
+    for (const auto& [i, j] : global) xrows[fill[j]++] = i;
+  }
+  // Pattern: column j holds the DOFs of every dense element touching j, the DOFs sparse elements couple to j, and
+  // the diagonal. Two passes (count, fill), each column independent, so the result does not depend on the thread
+  // count.
   colptr_.assign(n_ + 1, 0);
   auto column_rows = [&](int j, std::vector<int>* rows) {
     rows->clear();
     rows->push_back(j);
     for (int k = dptr[j]; k < dptr[j + 1]; ++k) {
       const int e = delem[k];
-      rows->insert(rows->end(), edofs.begin() + eptr[e], edofs.begin() + eptr[e + 1]);
+      if (!sparse_[e]) rows->insert(rows->end(), edofs.begin() + eptr[e], edofs.begin() + eptr[e + 1]);
     }
+    rows->insert(rows->end(), xrows.begin() + xptr[j], xrows.begin() + xptr[j + 1]);
     std::sort(rows->begin(), rows->end());
     rows->erase(std::unique(rows->begin(), rows->end()), rows->end());
   };
@@ -135,8 +162,10 @@ void Assembler::assemble(SparseMatrix* K, SparseMatrix* M) const {
                     (bad_size ? ": element matrix size does not match its DOF count" : ": non-finite entry in its element matrix");
           continue;
         }
-        // Positions of (dofs[a], dofs[b]) in the CSC arrays, by binary search in column dofs[b].
+        // Positions of (dofs[a], dofs[b]) in the CSC arrays, by binary search in column dofs[b]; a sparse
+        // element's zero entries need none (and may lie outside the pattern).
         pos.assign(static_cast<std::size_t>(nd) * nd, -1);
+        bool outside = false;
         for (int b = 0; b < nd; ++b) {
           const int j = dofs[b];
           if (j < 0) continue;
@@ -145,8 +174,20 @@ void Assembler::assemble(SparseMatrix* K, SparseMatrix* M) const {
           for (int a = 0; a < nd; ++a) {
             const int i = dofs[a];
             if (i < 0) continue;
-            pos[static_cast<std::size_t>(b) * nd + a] = static_cast<int>(std::lower_bound(first, last, i) - rows_.data());
+            if (sparse_[e] && (!K || Ke(a, b) == 0.0) && (!M || Me(a, b) == 0.0)) continue;
+            const int* it = std::lower_bound(first, last, i);
+            if (it == last || *it != i) {
+              outside = true;
+              continue;
+            }
+            pos[static_cast<std::size_t>(b) * nd + a] = static_cast<int>(it - rows_.data());
           }
+        }
+        if (outside) {
+#pragma omp critical(dynid_assembly_error)
+          if (error.empty())
+            error = "element " + std::to_string(e) + ": a nonzero entry between DOFs its coupling leaves out";
+          continue;
         }
         for (int b = 0; b < nd; ++b)
           for (int a = 0; a < nd; ++a) {

@@ -414,6 +414,12 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
   }
   const SparseMatrix& Ku = same_pattern ? K : Kcopy;
   const SparseMatrix& Mu = same_pattern ? M : Mcopy;
+  // The M products (every Lanczos step, the residuals) on M's nonzeros alone when they are few of the shared
+  // pattern's entries (lumped masses, massless DOFs): a diagonal M then costs n per product, not nnz(K).
+  const Eigen::Index m_nonzero = (Eigen::Map<const Eigen::ArrayXd>(Mu.valuePtr(), Mu.nonZeros()) != 0.0).count();
+  SparseMatrix Mpruned;
+  if (2 * m_nonzero < Mu.nonZeros()) Mpruned = Mu.pruned(0.0, 0.0);
+  const SparseMatrix& Mp = 2 * m_nonzero < Mu.nonZeros() ? Mpruned : Mu;
 
   EigenSolution sol;
   EigenSummary& sum = sol.summary;
@@ -573,7 +579,7 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
       bool ok = false;
       report(opt, "lanczos", -1);
       if (standard) {
-        TransformedOperator op(F, Mu, Yr);
+        TransformedOperator op(F, Mp, Yr);
         Spectra::SymEigsSolver<TransformedOperator> eigs(op, want, ncv);
         op.perform_op(x0.data(), v0.data());
         eigs.init(v0.data());
@@ -592,10 +598,10 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
         }
       } else {
         ShiftInvertOperator op(F, sigma, Phi, MPhi);
-        MassOperator Bop(Mu);
+        MassOperator Bop(Mp);
         using Solver = Spectra::SymGEigsShiftSolver<ShiftInvertOperator, MassOperator, Spectra::GEigsMode::ShiftInvert>;
         Solver eigs(op, Bop, want, ncv, sigma);
-        symmetric_multiply(Mu, x0.data(), b0.data());
+        symmetric_multiply(Mp, x0.data(), b0.data());
         op.perform_op(b0.data(), v0.data());
         eigs.init(v0.data());
         if (!lanczos(sum, [&] { eigs.compute(selection, opt.max_restarts, opt.tolerance, Spectra::SortRule::SmallestAlge); }))
@@ -657,11 +663,28 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
     sum.num_rigid = static_cast<int>(std::count(sol.rigid_body.begin(), sol.rigid_body.end(), 1));
   }
   finish(&sol);
+  // A supported structure whose K is singular to rounding (a mechanism: e.g. its only supports are springs of
+  // stiffness 0) may pass the LL^T of K with tiny positive pivots; its zero-energy motions then come back with
+  // eigenvalues at or below the rounding of the stiffness (1e3 eps max K_ii / M_ii). That is the breakdown the
+  // factorization missed: reported as such, at the DOF where the lowest motion is largest.
+  if (!band && r == 0 && !opt.allow_singular_stiffness && m > 0 &&
+      sol.eigenvalues[0] <= 1e3 * std::numeric_limits<double>::epsilon() * max_stiffness_to_mass(kd, md)) {
+    Eigen::Index at = 0;
+    sol.modes.col(0).cwiseAbs().maxCoeff(&at);
+    EigenSolution failed;
+    failed.summary = sum;
+    failed.summary.status = EigenStatus::kFactorizationFailed;
+    failed.summary.failed_dof = static_cast<int>(at);
+    failed.summary.message = "K is singular to rounding (an eigenvalue of " + std::to_string(sol.eigenvalues[0]) +
+                             "): the structure is a mechanism or is not supported; the zero-energy motion is largest "
+                             "at this DOF";
+    return failed;
+  }
   sol.residuals.resize(m);
   for (Eigen::Index k = 0; k < m; ++k) {
     Eigen::VectorXd kp(n), mp(n);
     symmetric_multiply(Ku, sol.modes.col(k).data(), kp.data());
-    symmetric_multiply(Mu, sol.modes.col(k).data(), mp.data());
+    symmetric_multiply(Mp, sol.modes.col(k).data(), mp.data());
     const double lamk = sol.eigenvalues[k];
     sol.residuals[k] = (kp - lamk * mp).norm() / ((nK + std::abs(lamk) * nM) * sol.modes.col(k).norm());
   }

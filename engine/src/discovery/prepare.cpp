@@ -24,26 +24,19 @@ double median(std::vector<double> v) {
 void add_contamination(const ModalData& data, NoiseModel* nm) {
   const int p = data.num_modes();
   if (data.mpc.size() != p || p == 0) return;
-  Eigen::VectorXd f = nm->frequency_modes.size() == p ? nm->frequency_modes : Eigen::VectorXd::Constant(p, nm->frequency);
-  Eigen::VectorXd s = nm->shape_modes.size() == p ? nm->shape_modes : Eigen::VectorXd::Constant(p, nm->shape);
+  Eigen::VectorXd f =
+      nm->frequency_modes.size() == p ? nm->frequency_modes : Eigen::VectorXd::Constant(p, nm->frequency);
   bool any = false;
   for (int k = 0; k < p; ++k) {
     const double mpc = std::clamp(data.mpc[k], 0.0, 1.0);
     if (!(mpc < 1)) continue;
     // Out-of-phase to in-phase energy of the identified shape: MPC = ((A - B) / (A + B))^2.
     const double c = (1 - std::sqrt(mpc)) / (1 + std::sqrt(mpc));
-    const Eigen::VectorXd u = data.shapes.col(k);
-    const double top = u.cwiseAbs().maxCoeff();
-    if (!(top > 0)) continue;
-    const double rms = u.norm() / top / std::sqrt(static_cast<double>(std::max<Eigen::Index>(1, u.size())));
-    s[k] = std::hypot(s[k], std::sqrt(c) * rms);
     const double zeta = data.damping_ratios.size() == p && std::isfinite(data.damping_ratios[k]) ? std::abs(data.damping_ratios[k]) : 0.0;
     f[k] = std::hypot(f[k], zeta * std::sqrt(c));
     any = true;
   }
-  if (!any) return;
-  nm->frequency_modes = f;
-  nm->shape_modes = s;
+  if (any) nm->frequency_modes = f;
 }
 
 NoiseModel noise_model(const ModalData& data, const DiscoveryOptions& o, std::vector<std::string>* warnings) {

@@ -47,11 +47,20 @@ struct MultiStartSummary {
   std::vector<Eigen::VectorXd> start_points; ///< every start (all parameters)
   std::vector<double> start_cost;            ///< final cost of every start (+inf: it failed)
   std::vector<std::string> start_error;      ///< why a start failed ("" = it did not)
+  std::vector<int> start_iterations, start_evaluations;  ///< Ceres iterations and model evaluations of every start
+  std::vector<char> start_converged;                     ///< every start: Ceres reported CONVERGENCE
+  std::vector<double> start_time;                        ///< seconds of every start (its own wall time)
   int failed = 0;
   double time_wall = 0;          ///< seconds for all starts
-  double time_cpu = 0;           ///< sum of the starts' own times
+  double time_cpu = 0;           ///< processor time of the process during the search (all threads; std::clock)
   std::vector<std::string> warnings;
 };
+
+/// The starting points of the search (all parameters): the user's values, then the Latin hypercube. Throws
+/// InputError for invalid options, or a free parameter without finite bounds.
+std::vector<Eigen::VectorXd> multistart_points(const ParametricModel& pm, const Eigen::VectorXd& theta0,
+                                               const std::vector<char>& free, const FitOptions& options,
+                                               const MultiStartOptions& ms);
 
 /// Runs the global search. Parameters that are free must have finite bounds (InputError otherwise); fixed and
 /// tied ones behave as in fit_parameters. Throws NumericalError when every start fails.

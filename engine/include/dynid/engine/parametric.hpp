@@ -94,8 +94,13 @@ class ParametricModel {
   // A part of an element (or an added mass/spring) whose matrix scales with a product of parameters.
   struct Term {
     std::vector<int> dofs;      // global equations (-1 = restrained)
-    Eigen::MatrixXd A;          // element-level matrix at nominal
+    Eigen::MatrixXd A;          // element-level matrix at nominal (dense terms; empty for sparse ones)
     std::vector<int> pos;       // CSC positions of the free (a, b) pairs, row-major over (a, b); -1 skipped
+    /// Sparse terms (elements assembled on their coupling, Model::element_coupling): the nonzero free entries
+    /// (ea[t], eb[t]) of the element-level matrix, their values ev[t] and CSC positions epos[t]; A and pos empty.
+    bool sparse = false;
+    std::vector<int> ea, eb, epos;
+    std::vector<double> ev;
     bool mass = false;          // contributes to M (else K)
     std::vector<int> params;    // parameters multiplying it
     bool additive = false;      // scale = theta_p (additive kinds) instead of a product of factors

@@ -15,6 +15,7 @@
 #include "dynid/engine/model_fit.hpp"
 #include "dynid/engine/multistart.hpp"
 #include "dynid/engine/parametric.hpp"
+#include "dynid/engine/regularization.hpp"
 #include "dynid/engine/virtual_test.hpp"
 #include "dynid/io/limits.hpp"
 #include "dynid/io/mat_file.hpp"
@@ -65,6 +66,8 @@ struct UpdateSpec {
   FitOptions options;
   bool multistart = false;               ///< global search (multistart:), with:
   MultiStartOptions search;
+  bool lcurve = false;  ///< regularization: l-curve (the weight chosen by the L-curve rule)
+  LCurveOptions lcurve_options;
 };
 
 /// What `test:` asks for (docs/case-file.md): a virtual test of the case's model (`dynid simulate-test`), the

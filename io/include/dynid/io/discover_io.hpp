@@ -26,14 +26,16 @@ struct DiscoveryData {
 /// noise seed (robustness studies).
 DiscoveryData discovery_data(const Case& c, int seed_offset = 0);
 
-/// How a discovery compares with the case's `expect:`.
+/// How a discovery compares with the case's `expect:`. A stiffness change named over another element set than the
+/// expected one is compared with the expected change's flexibility average over the named set (element lengths
+/// from `model`).
 struct ExpectCheck {
   bool verdict = false, kind = false, location = false, parameter = true, also = true;
   double parameter_error = 0;  ///< relative
   std::string words;
   bool ok() const { return verdict && kind && location && parameter && also; }
 };
-ExpectCheck check_expectation(const DiscoverSpec::Expect& e, const DiscoverySummary& s);
+ExpectCheck check_expectation(const DiscoverSpec::Expect& e, const DiscoverySummary& s, const Model& model);
 
 /// A site in short form: "n4" + sep + "e37".
 std::string site_label(const Site& s, const std::string& sep);

@@ -11,6 +11,7 @@
 #include "dynid/engine/detect.hpp"
 #include "dynid/engine/model_fit.hpp"
 #include "dynid/engine/parametric.hpp"
+#include "dynid/engine/regularization.hpp"
 #include "dynid/io/case_file.hpp"
 #include "dynid/io/discover_io.hpp"
 
@@ -31,6 +32,7 @@ struct UpdateRun {
   std::unique_ptr<ParametricModel> pm;
   FitSummary fit;                        ///< the fit (with multistart: the best start's)
   std::optional<MultiStartSummary> search;  ///< the global search, when the case asks for it
+  std::optional<LCurveSummary> lcurve;      ///< the L-curve that chose the regularization weight, when asked for
 };
 /// `measured`, when given, replaces the case's measured data (a host's own modes; the first update: modes used).
 UpdateRun update_case(const Case& c, const ModalData* measured = nullptr);
@@ -40,9 +42,12 @@ UpdateRun update_case(const Case& c, const ModalData* measured = nullptr);
 /// values, which parameters are free, the ties and the objective. With `search` (multistart), also "multistart":
 /// {"starts", "seed", "continuation", "same_minimum", "failed", "best_start", "distinct_minima", "minima" (lowest
 /// cost first: cost, starts, parameters, frequencies_hz, mac, max_frequency_error, mean_mac, at_bound, converged),
-/// "start_costs", "time_wall_s", "time_cpu_s"}.
+/// "start_costs", "start_iterations", "start_evaluations", "start_seconds", "time_wall_s", "time_cpu_s"}. With a
+/// regularization weight or `lcurve`, also "regularization": {"rule" (fixed | l-curve), "weight", and for the
+/// L-curve "corner" and "points" (weight, misfit, size, curvature, converged; smallest weight first)}.
 nlohmann::json update_json(const std::string& case_name, const ParametricModel& pm, const UpdateSpec& u,
-                           const FitSummary& f, const MultiStartSummary* search = nullptr);
+                           const FitSummary& f, const MultiStartSummary* search = nullptr,
+                           const LCurveSummary* lcurve = nullptr);
 
 /// The measured modes of a discover: case given in memory instead of the case's measured: / recordings: (host
 /// codes, Python): modal data, kept as discovery_data() keeps a file's (min_mpc, modes), or recordings,

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <utility>
 #include <vector>
 
 namespace dynid {
@@ -16,6 +17,9 @@ namespace dynid {
 ///    coordinates, symmetric, full storage. Either pointer may be null (not wanted). Implementations resize the
 ///    output and must not keep hidden mutable state: they are called concurrently from several threads.
 ///  * The same element always gets the same DOF list (the sparsity pattern is computed once).
+///  * element_coupling(e, &pairs) may say which pairs of an element's DOFs can hold nonzero entries (sparse element
+///    matrices, e.g. a group of a structure exported from another FE code): assembly then reserves only those
+///    (and the diagonal). The default says every pair can (dense element matrices).
 class ElementSource {
  public:
   virtual ~ElementSource() = default;
@@ -23,6 +27,12 @@ class ElementSource {
   virtual int num_elements() const = 0;
   virtual void element_dofs(int e, std::vector<int>* dofs) const = 0;
   virtual void element_matrices(int e, Eigen::MatrixXd* K, Eigen::MatrixXd* M) const = 0;
+  /// Sparse elements: true, with the pairs (a, b), a < b, of element_dofs() positions whose entries may be nonzero
+  /// (an entry outside them must be zero in K and M). Dense elements: false (every pair may be nonzero).
+  virtual bool element_coupling(int e, std::vector<std::pair<int, int>>* pairs) const {
+    pairs->clear();
+    return false;
+  }
 };
 
 }  // namespace dynid

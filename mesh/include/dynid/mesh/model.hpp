@@ -168,6 +168,9 @@ class Model : public ElementSource {
   int num_elements() const override { return static_cast<int>(elements_.size()); }
   void element_dofs(int e, std::vector<int>* dofs) const override;
   void element_matrices(int e, Eigen::MatrixXd* K, Eigen::MatrixXd* M) const override;
+  /// Matrix elements are coupled node by node: two nodes' DOF blocks are reserved when some K or M entry between
+  /// them is nonzero (each node's own block always is). False when that is every pair (and for other elements).
+  bool element_coupling(int e, std::vector<std::pair<int, int>>* pairs) const override;
 
   /// DOF types of element e at each of its nodes, in element-matrix order (node-major).
   std::vector<std::pair<int, Dof>> element_dof_types(int e) const;
@@ -208,6 +211,8 @@ class Model : public ElementSource {
   std::vector<std::array<int, 2>> element_nodes_;
   std::vector<DofMask> point_mass_dofs_;  // per element: DOFs a point mass acts on (set at finalize)
   std::vector<std::vector<std::pair<int, Dof>>> matrix_dofs_;  // per Matrix element: (node index, DOF type)
+  std::vector<std::vector<std::pair<int, int>>> matrix_coupling_;  // per sparse Matrix element (element_coupling)
+  std::vector<char> matrix_sparse_;
   MassType mass_type_ = MassType::Consistent;
   bool rotary_inertia_ = false;
   bool free_free_ = false;

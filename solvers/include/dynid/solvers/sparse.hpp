@@ -13,7 +13,8 @@ namespace dynid {
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
 /// Assembles global K and M from an ElementSource. The constructor does the symbolic work once: the CSC pattern
-/// (union of all element DOF pairs; K and M share it, so K - sigma M has the same pattern) and a colouring of the
+/// (union of all element DOF pairs, or of the coupled pairs of sparse elements (ElementSource::element_coupling);
+/// K and M share it, so K - sigma M has the same pattern) and a colouring of the
 /// elements such that no two elements of one colour share a DOF. Numeric assembly then runs colour by colour
 /// with OpenMP; each matrix entry receives its contributions in colour order whatever the thread count, so the
 /// result is bitwise identical for any number of threads.
@@ -36,6 +37,7 @@ class Assembler {
   int n_ = 0;
   std::vector<int> colptr_, rows_;
   std::vector<int> color_ptr_, color_elems_;  // elements grouped by colour
+  std::vector<char> sparse_;                  // per element: assembled on its coupling (element_coupling)
 };
 
 /// Parallel y = A x for a matrix stored with both triangles (uses symmetry: row i = column i). Deterministic.
