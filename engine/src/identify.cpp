@@ -403,8 +403,12 @@ Eigen::VectorXcd principal(const Eigen::MatrixXcd& Rr) {
 
 // A cluster's shape for the evidence checks: the principal vector of its residues from the lines around it,
 // fitted together with the poles of the other clusters that get a shape (internal::kShapedShare) in that window.
+// When that joint fit leaves the shape complex (MPC below min_mpc) and the fit of its pole alone does not, the
+// alone fit's shape: two poles within one peak's width share its lines, and the joint fit can split one mode's
+// residue between them at random phase (a close pair the data cannot separate is then judged as a split).
 internal::ClusterShape lscf_cluster_shape(const LscfInput& in, const std::vector<internal::PoleCluster>& clusters,
-                                          std::size_t c, double window_decay, double resolution_hz, double min_share) {
+                                          std::size_t c, double window_decay, double resolution_hz, double min_share,
+                                          double min_mpc) {
   auto windowed = [&](const internal::PoleCluster& q) {
     return internal::pole_of(q.frequency_hz, q.damping_ratio) - window_decay;
   };
@@ -417,9 +421,15 @@ internal::ClusterShape lscf_cluster_shape(const LscfInput& in, const std::vector
     if (q != c && clusters[q].support >= min_share &&
         std::abs(2 * kPi * clusters[q].frequency_hz - pw.imag()) <= half_width)
       others.push_back(windowed(clusters[q]));
-  const Eigen::VectorXcd R = local_residues(in.w, in.H, pw, others, half_width);
+  auto shape = [&](const std::vector<std::complex<double>>& with) {
+    return principal(outputs_by_inputs(local_residues(in.w, in.H, pw, with, half_width).transpose(), in.no, in.ni));
+  };
   internal::ClusterShape cs;
-  cs.shape = principal(outputs_by_inputs(R.transpose(), in.no, in.ni));
+  cs.shape = shape(others);
+  if (!others.empty() && modal_phase_collinearity(cs.shape) < min_mpc) {
+    const Eigen::VectorXcd alone = shape({});
+    if (modal_phase_collinearity(alone) >= min_mpc) cs.shape = alone;
+  }
   cs.strength = cs.shape.norm() / std::abs(pw.real());
   return cs;
 }
@@ -694,7 +704,8 @@ IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationO
   internal::select_modes(
       poles, in.lo, in.hi, o, s.background.cwiseAbs2(), decay,
       [&](const std::vector<internal::PoleCluster>& all, std::size_t c) {
-        return lscf_cluster_shape(in, all, c, decay, s.resolution_hz, internal::kShapedShare * o.min_cluster_fraction);
+        return lscf_cluster_shape(in, all, c, decay, s.resolution_hz, internal::kShapedShare * o.min_cluster_fraction,
+                                  o.min_mpc);
       },
       [&](const Eigen::VectorXcd& u) { return projected_frf_power(frf_in, u); }, s);
   lscf_final_modes(in, frf_in, decay, o, s);
