@@ -394,6 +394,10 @@ nlohmann::ordered_json discovery_json(const Case& c, const DiscoveryData& d, con
   auto source = [](NoiseModel::Source x) { return x == NoiseModel::Source::kStated ? "stated" : x == NoiseModel::Source::kData ? "data" : "default"; };
   j["noise"] = {{"frequency", s.noise.frequency}, {"frequency_source", source(s.noise.frequency_source)},
                 {"shape", s.noise.shape}, {"shape_source", source(s.noise.shape_source)}, {"scale_frequency", s.noise_scale_frequency}, {"scale_shape", s.noise_scale_shape}};
+  // Per measured mode used: the frequency noise and its discretization part (relative; empty when not per mode).
+  auto per_mode = [](const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); };
+  j["noise"]["frequency_modes"] = per_mode(s.noise.frequency_modes);
+  j["noise"]["discretization"] = per_mode(s.noise.discretization);
   j["set_aside"] = nlohmann::ordered_json::array();
   for (const SetAside& a : s.set_aside)
     j["set_aside"].push_back({{"mode", a.mode + 1}, {"frequency_hz", a.frequency_hz},
