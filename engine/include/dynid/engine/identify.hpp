@@ -18,7 +18,8 @@
 //      deviations are the spread over orders.
 //   3. Evidence, each a reason to reject a cluster (listed in IdentificationSummary::rejected). Each cluster's
 //      shape is judged as estimated beside its neighbours (LSCF: residues from the lines around it, fitted with
-//      the poles of the clusters near it, so that each of a close pair gets its own), and its mode indicator is
+//      the poles of the clusters near it, so that each of a close pair gets its own; its pole alone when that joint
+//      fit leaves the shape complex and the alone fit does not), and its mode indicator is
 //      seen through that shape (the FRFs' |u^H H|^2, the output spectra's u^H G u), where the weaker mode of a
 //      close pair has its own peak:
 //        support below min_cluster_fraction (not stable over enough orders);
