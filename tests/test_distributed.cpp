@@ -19,33 +19,8 @@ namespace {
 
 Material Steel() { return {"steel", 2.1e11, 0, 0.3, 7800}; }
 
-// A 3D frame without symmetry in plan (spans 5 m x 4 m, 3 x 2 bays): simple eigenvalues, ~1,000 DOFs.
-Frame3DSpec Frame() {
-  Frame3DSpec s;
-  s.bays_x = 3;
-  s.bays_y = 2;
-  s.stories = 4;
-  s.divisions = 2;
-  s.span_x = 5;
-  s.span_y = 4;
-  s.height = 3;
-  s.material = Steel();
-  s.column = {"col", 4e-3, 8e-6, 1.2e-5, 0};
-  s.beam = {"beam", 3e-3, 5e-6, 9e-6, 0};
-  return s;
-}
-
-Model FreeFree(const Model& base) {
-  Model m;
-  m.add_material(base.materials()[0]);
-  m.add_section(base.sections()[0]);
-  m.add_section(base.sections()[1]);
-  for (const Node& n : base.nodes()) m.add_node(n.id, n.x);
-  for (const Element& e : base.elements()) m.add_element(e);
-  m.set_free_free(true);
-  m.finalize();
-  return m;
-}
+// ~1,000 DOFs.
+Frame3DSpec Frame() { return test::SteelFrame3D(3, 2, 4); }
 
 EigenOptions Options(int modes, EigenOptions::Backend backend) {
   EigenOptions o;
@@ -91,7 +66,7 @@ TEST(Distributed, MatchesLocalOnA3DFrame) {
 }
 
 TEST(Distributed, MatchesLocalFreeFreeWithRigidBodyModes) {
-  const Model m = FreeFree(make_frame3d(Frame()));
+  const Model m = test::WithoutSupports(make_frame3d(Frame()));
   const ModalResult local = modal_analysis(m, Options(14, EigenOptions::Backend::kLocal));
   const ModalResult dist = modal_analysis(m, Options(14, EigenOptions::Backend::kDistributed));
   ExpectSameModes(local, dist, 1e-10);

@@ -25,20 +25,7 @@ Frame2DSpec Frame2D(int bays, int stories, int div) {
   return s;
 }
 
-Frame3DSpec Frame3D() {
-  Frame3DSpec s;
-  s.bays_x = 2;
-  s.bays_y = 2;
-  s.stories = 3;
-  s.divisions = 2;
-  s.span_x = 5;
-  s.span_y = 4;
-  s.height = 3;
-  s.material = Steel();
-  s.column = {"col", 4e-3, 8e-6, 1.2e-5, 0};
-  s.beam = {"beam", 3e-3, 5e-6, 9e-6, 0};
-  return s;
-}
+Frame3DSpec Frame3D() { return test::SteelFrame3D(2, 2, 3); }
 
 // Solves a model with both paths and checks: eigenvalues to 1e-8 relative (elastic modes; rigid ones ~0 are
 // compared in absolute terms against the first elastic eigenvalue), mode shapes (MAC > 1 - 1e-8 for simple
@@ -97,16 +84,7 @@ TEST(Eigen, SparseMatchesDense3DFrame) { CompareSparseDense(make_frame3d(Frame3D
 
 TEST(Eigen, SparseMatchesDenseFreeFree3DFrame) {
   // Remove the supports: 6 rigid-body modes, found from the geometry and reported first.
-  Frame3DSpec s = Frame3D();
-  Model base = make_frame3d(s);
-  Model m;
-  m.add_material(base.materials()[0]);
-  m.add_section(base.sections()[0]);
-  m.add_section(base.sections()[1]);
-  for (const Node& n : base.nodes()) m.add_node(n.id, n.x);
-  for (const Element& e : base.elements()) m.add_element(e);
-  m.set_free_free(true);
-  m.finalize();
+  const Model m = test::WithoutSupports(make_frame3d(Frame3D()));
   CompareSparseDense(m, 16);
   EigenOptions o;
   o.num_modes = 8;

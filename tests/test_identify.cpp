@@ -185,7 +185,7 @@ struct SplitPair {
     }
   }
   std::vector<std::vector<std::size_t>> check() {
-    return internal::check_evidence(cands, ev, power, IdentificationOptions{}, 10, s);
+    return internal::check_evidence(cands, ev, {power, power}, IdentificationOptions{}, 10, s);
   }
 };
 

@@ -9,6 +9,32 @@
 
 namespace dynid::test {
 
+Frame3DSpec SteelFrame3D(int bays_x, int bays_y, int stories) {
+  Frame3DSpec s;
+  s.bays_x = bays_x;
+  s.bays_y = bays_y;
+  s.stories = stories;
+  s.divisions = 2;
+  s.span_x = 5;
+  s.span_y = 4;
+  s.height = 3;
+  s.material = {"steel", 2.1e11, 0, 0.3, 7800};
+  s.column = {"col", 4e-3, 8e-6, 1.2e-5, 0};
+  s.beam = {"beam", 3e-3, 5e-6, 9e-6, 0};
+  return s;
+}
+
+Model WithoutSupports(const Model& base) {
+  Model m;
+  for (const Material& x : base.materials()) m.add_material(x);
+  for (const Section& x : base.sections()) m.add_section(x);
+  for (const Node& n : base.nodes()) m.add_node(n.id, n.x);
+  for (const Element& e : base.elements()) m.add_element(e);
+  m.set_free_free(true);
+  m.finalize();
+  return m;
+}
+
 double SubspaceGap(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
   const Eigen::MatrixXd Qa = Eigen::HouseholderQR<Eigen::MatrixXd>(A).householderQ() *
                              Eigen::MatrixXd::Identity(A.rows(), A.cols());

@@ -10,6 +10,7 @@
 
 #include "dynid/engine/identify.hpp"
 #include "dynid/mesh/error.hpp"
+#include "dynid/mesh/generators.hpp"
 #include "dynid/solvers/sparse.hpp"
 
 /// `text` (a std::string or a C string) contains `part`; the text is shown when it does not.
@@ -94,5 +95,12 @@ namespace dynid::test {
 
 /// Dense copy of a sparse matrix.
 inline Eigen::MatrixXd Dense(const SparseMatrix& A) { return Eigen::MatrixXd(A); }
+
+/// A steel 3D frame without symmetry in plan (spans 5 m x 4 m, storeys 3 m, members in 2 elements): simple
+/// eigenvalues.
+Frame3DSpec SteelFrame3D(int bays_x, int bays_y, int stories);
+
+/// The model with its supports removed, declared free-free (finalized): 6 rigid-body modes.
+Model WithoutSupports(const Model& base);
 
 }  // namespace dynid::test

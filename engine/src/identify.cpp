@@ -67,27 +67,37 @@ Eigen::MatrixXcd lsfd(const Eigen::VectorXd& w, const Eigen::MatrixXcd& H, const
   return R;
 }
 
-// Residues of every FRF column at one pole from the lines around it alone (a local LSFD: the pole's pair and a
-// complex constant plus slope for everything else). For judging a cluster: near-duplicate poles of one mode do
-// not share (and scramble) one residue as they would in a joint fit. Returns one residue per column.
-Eigen::VectorXcd local_residues(const Eigen::VectorXd& w, const Eigen::MatrixXcd& H, std::complex<double> pole, double half_width) {
+// Residues of every FRF column at a pole from the lines around it (a local LSFD: the pole's pair, the pairs of
+// the `others` poles, and a complex constant plus slope for everything else). For judging a cluster: fitted with
+// its neighbours' poles, the two modes of a closely spaced pair each get their own residue (alone, each takes up
+// both); near-duplicate poles of one mode share its residue with parallel vectors (the split check merges them).
+// Returns the first pole's residue per column.
+Eigen::VectorXcd local_residues(const Eigen::VectorXd& w, const Eigen::MatrixXcd& H, std::complex<double> pole,
+                                const std::vector<std::complex<double>>& others, double half_width) {
   const Eigen::Index nf = w.size();
   const double wr = pole.imag();
+  const Eigen::Index np = 1 + static_cast<Eigen::Index>(others.size()), nu = 2 * np + 4;
   Eigen::Index a = std::lower_bound(w.data(), w.data() + nf, wr - half_width) - w.data();
   Eigen::Index b = std::upper_bound(w.data(), w.data() + nf, wr + half_width) - w.data();
-  while (b - a < 8 && (a > 0 || b < nf)) {
+  while (b - a < std::max<Eigen::Index>(8, nu) && (a > 0 || b < nf)) {
     if (a > 0) --a;
     if (b < nf) ++b;
   }
   const Eigen::Index n = b - a;
   const std::complex<double> I(0, 1);
-  Eigen::MatrixXcd B(n, 6);
+  Eigen::MatrixXcd B(n, nu);
   for (Eigen::Index k = 0; k < n; ++k) {
-    const std::complex<double> sk = I * w[a + k], p = 1.0 / (sk - pole), q = 1.0 / (sk - std::conj(pole));
+    const std::complex<double> sk = I * w[a + k];
+    for (Eigen::Index r = 0; r < np; ++r) {
+      const std::complex<double> pr = r == 0 ? pole : others[static_cast<std::size_t>(r - 1)];
+      const std::complex<double> p = 1.0 / (sk - pr), q = 1.0 / (sk - std::conj(pr));
+      B(k, 2 * r) = p + q;
+      B(k, 2 * r + 1) = I * p - I * q;
+    }
     const double x = (w[a + k] - wr) / std::max(half_width, 1e-300);
-    B.row(k) << p + q, I * p - I * q, 1.0, I, x, I * x;
+    B.row(k).tail(4) << 1.0, I, x, I * x;
   }
-  Eigen::MatrixXd A(2 * n, 6), rhs(2 * n, H.cols());
+  Eigen::MatrixXd A(2 * n, nu), rhs(2 * n, H.cols());
   A << B.real(), B.imag();
   rhs << H.middleRows(a, n).real(), H.middleRows(a, n).imag();
   const Eigen::VectorXd scale = A.colwise().norm().cwiseMax(1e-300).cwiseInverse();
@@ -144,6 +154,7 @@ bool IdentificationOptions::IsValid(std::string* why) const {
   if (!(cluster_damping > 0)) return fail("the cluster damping tolerance must be > 0");
   if (!(min_cluster_fraction > 0 && min_cluster_fraction <= 1)) return fail("the cluster fraction must be in (0, 1]");
   if (!(cluster_tolerance > 0 && cluster_tolerance < 0.5)) return fail("the cluster tolerance must be in (0, 0.5)");
+  if (!(cluster_mac > 0 && cluster_mac < 1)) return fail("the cluster MAC must be in (0, 1)");
   if (block_rows < 0 || decimate < 0) return fail("block rows and decimation must be >= 0");
   if (!(min_mpc >= 0 && min_mpc <= 1)) return fail("the MPC limit must be in [0, 1]");
   if (!std::isfinite(min_peak_db) || !(max_edge_db > 0)) return fail("the indicator peak limit must be finite and the edge limit > 0 dB");
@@ -390,14 +401,46 @@ Eigen::VectorXcd principal(const Eigen::MatrixXcd& Rr) {
   return svd.matrixU().col(0) * svd.singularValues()[0];
 }
 
-// A cluster's shape for the evidence checks: the principal vector of its residues from the lines around it.
-Eigen::VectorXcd lscf_cluster_shape(const LscfInput& in, const internal::PoleCluster& c, double window_decay,
-                                    double resolution_hz) {
-  const double zw = c.damping_ratio + window_decay / (2 * kPi * c.frequency_hz);
-  const std::complex<double> pw = internal::pole_of(c.frequency_hz, c.damping_ratio) - window_decay;
-  const Eigen::VectorXcd R =
-      local_residues(in.w, in.H, pw, std::max(3 * zw * std::abs(pw), 5 * 2 * kPi * resolution_hz));
-  return principal(outputs_by_inputs(R.transpose(), in.no, in.ni));
+// A cluster's shape for the evidence checks: the principal vector of its residues from the lines around it,
+// fitted together with the poles of the other clusters that get a shape (internal::kShapedShare) in that window.
+// When that joint fit leaves the shape complex (MPC below min_mpc) and the fit of its pole alone does not, the
+// alone fit's shape: two poles within one peak's width share its lines, and the joint fit can split one mode's
+// residue between them at random phase (a close pair the data cannot separate is then judged as a split).
+internal::ClusterShape lscf_cluster_shape(const LscfInput& in, const std::vector<internal::PoleCluster>& clusters,
+                                          std::size_t c, double window_decay, double resolution_hz, double min_share,
+                                          double min_mpc) {
+  auto windowed = [&](const internal::PoleCluster& q) {
+    return internal::pole_of(q.frequency_hz, q.damping_ratio) - window_decay;
+  };
+  const internal::PoleCluster& me = clusters[c];
+  const double zw = me.damping_ratio + window_decay / (2 * kPi * me.frequency_hz);
+  const std::complex<double> pw = windowed(me);
+  const double half_width = std::max(3 * zw * std::abs(pw), 5 * 2 * kPi * resolution_hz);
+  std::vector<std::complex<double>> others;
+  for (std::size_t q = 0; q < clusters.size(); ++q)
+    if (q != c && clusters[q].support >= min_share &&
+        std::abs(2 * kPi * clusters[q].frequency_hz - pw.imag()) <= half_width)
+      others.push_back(windowed(clusters[q]));
+  auto shape = [&](const std::vector<std::complex<double>>& with) {
+    return principal(outputs_by_inputs(local_residues(in.w, in.H, pw, with, half_width).transpose(), in.no, in.ni));
+  };
+  internal::ClusterShape cs;
+  cs.shape = shape(others);
+  if (!others.empty() && modal_phase_collinearity(cs.shape) < min_mpc) {
+    const Eigen::VectorXcd alone = shape({});
+    if (modal_phase_collinearity(alone) >= min_mpc) cs.shape = alone;
+  }
+  cs.strength = cs.shape.norm() / std::abs(pw.real());
+  return cs;
+}
+
+// The FRFs seen through a shape u: |u^H H|^2 / |u|^2 summed over the inputs, at every line.
+Eigen::VectorXd projected_frf_power(const FrfData& frf, const Eigen::VectorXcd& u) {
+  const int ni = frf.num_inputs(), no = frf.num_outputs();
+  const double uu = std::max(u.squaredNorm(), 1e-300);
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(frf.frequency_hz.size());
+  for (int i = 0; i < ni; ++i) out += (frf.H.middleCols(i * no, no) * u.conjugate()).cwiseAbs2();
+  return out / uu;
 }
 
 // LSFD at the modes' poles of the windowed data (the window's decay put back): shapes and contributions.
@@ -417,6 +460,79 @@ void lscf_mode_shapes(const LscfInput& in, double window_decay, IdentificationSu
   }
   for (IdentifiedMode& m : s.modes) m.contribution = top > 0 ? m.contribution / top : 0;
   mark_twins(s.modes, true);
+}
+
+// Removes the modes marked in `drop` from s.modes, listing each in s.rejected with its reason (kSplit: merged
+// into `into`), and renumbers the diagram poles' and rejected splits' modes.
+void reject_modes(IdentificationSummary& s, const std::vector<Rejection>& why, const std::vector<char>& drop,
+                  const std::vector<double>& value, const std::vector<double>& limit, const std::vector<int>& into) {
+  std::vector<int> index(s.modes.size(), -1);
+  std::vector<IdentifiedMode> kept;
+  for (std::size_t k = 0; k < s.modes.size(); ++k)
+    if (!drop[k]) index[k] = static_cast<int>(kept.size()), kept.push_back(s.modes[k]);
+  for (RejectedCluster& r : s.rejected)
+    if (r.merged_into >= 0) r.merged_into = index[static_cast<std::size_t>(r.merged_into)];
+  for (std::size_t k = 0; k < s.modes.size(); ++k) {
+    if (!drop[k]) continue;
+    const IdentifiedMode& m = s.modes[k];
+    RejectedCluster rc;
+    rc.frequency_hz = m.frequency_hz;
+    rc.damping_ratio = m.damping_ratio;
+    rc.poles = m.poles;
+    rc.support = m.support;
+    rc.reason = why[k];
+    rc.value = value[k];
+    rc.limit = limit[k];
+    rc.merged_into = into[k] >= 0 ? index[static_cast<std::size_t>(into[k])] : -1;
+    s.rejected.push_back(rc);
+  }
+  for (StabilizationPole& p : s.poles)
+    if (p.cluster >= 0) p.cluster = index[static_cast<std::size_t>(p.cluster)];
+  std::stable_sort(s.rejected.begin(), s.rejected.end(),
+                   [](const RejectedCluster& a, const RejectedCluster& b) { return a.frequency_hz < b.frequency_hz; });
+  s.modes = std::move(kept);
+}
+
+// The modes' final shapes (LSFD at all of them together) judged as the clusters' were: a mode whose shape is not
+// a normal mode's (MPC below min_mpc) or repeats a stronger mode's (a split, by the rule of the selection, the
+// stronger by contribution) is rejected and the others are fitted again without it. The clusters' shapes were
+// local; the joint fit may hand a pole that only fits a neighbour's residual error that neighbour's shape.
+void lscf_final_modes(const LscfInput& in, const FrfData& frf_in, double window_decay, const IdentificationOptions& o,
+                      IdentificationSummary& s) {
+  for (int pass = 0; pass < 4; ++pass) {
+    lscf_mode_shapes(in, window_decay, s);
+    const std::size_t n = s.modes.size();
+    std::vector<char> drop(n, 0);
+    std::vector<Rejection> why(n, Rejection::kComplexShape);
+    std::vector<double> value(n, 0), limit(n, 0);
+    std::vector<int> into(n, -1);
+    for (std::size_t k = 0; k < n; ++k)
+      if (s.modes[k].mpc < o.min_mpc) drop[k] = 1, value[k] = s.modes[k].mpc, limit[k] = o.min_mpc;
+    std::vector<std::size_t> order;
+    for (std::size_t k = 0; k < n; ++k)
+      if (!drop[k]) order.push_back(k);
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return s.modes[a].contribution > s.modes[b].contribution; });
+    auto side = [&](std::size_t k) {
+      return internal::SplitSide{s.modes[k].frequency_hz, s.modes[k].damping_ratio,
+                                 s.modes[k].real_shape.cast<std::complex<double>>()};
+    };
+    for (std::size_t a = 1; a < order.size(); ++a)
+      for (std::size_t b = 0; b < a && !drop[order[a]]; ++b) {
+        const std::size_t c = order[a], h = order[b];
+        if (drop[h]) continue;
+        const Eigen::VectorXd ind = projected_frf_power(frf_in, s.modes[h].shape);
+        const double zw = s.modes[h].damping_ratio + window_decay / (2 * kPi * s.modes[h].frequency_hz);
+        const double peak = internal::indicator_evidence(s.frequency_hz, ind, s.modes[h].frequency_hz, zw).peak_db;
+        if (internal::is_split(side(c), side(h), peak, s.frequency_hz, ind, o)) {
+          drop[c] = 1, why[c] = Rejection::kSplit, into[c] = static_cast<int>(h);
+          value[c] = complex_mac(side(c).shape, side(h).shape), limit[c] = o.merge_mac;
+        }
+      }
+    if (std::find(drop.begin(), drop.end(), 1) == drop.end()) return;
+    reject_modes(s, why, drop, value, limit, into);
+  }
+  lscf_mode_shapes(in, window_decay, s);
 }
 
 // ---- SSI-cov stages -------------------------------------------------------------------------------------------
@@ -513,8 +629,8 @@ internal::OrderPoles ssi_poles(const Eigen::MatrixXd& Tm, const SsiSetup& u) {
 
 // Background and mode indicator: the first singular value of the output cross-spectral matrix (Welch, the
 // plan's resolution when given, else segments of 8 periods of the lowest frequency of interest).
-void output_spectrum_indicator(const std::vector<Eigen::MatrixXd>& records, const SsiSetup& u,
-                               const IdentificationOptions& o, IdentificationSummary& s) {
+CrossSpectra output_spectrum_indicator(const std::vector<Eigen::MatrixXd>& records, const SsiSetup& u,
+                                       const IdentificationOptions& o, IdentificationSummary& s) {
   WelchOptions wo;
   int seg = 8;
   const Eigen::Index shortest = std::min_element(records.begin(), records.end(), [](const auto& a, const auto& b) {
@@ -533,6 +649,16 @@ void output_spectrum_indicator(const std::vector<Eigen::MatrixXd>& records, cons
   for (Eigen::Index k = 0; k < G.frequency.size(); ++k)
     s.background[k] = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXcd>(G.G[k], Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
   s.background_label = "first singular value of the output spectral matrix";
+  return G;
+}
+
+// The output spectral matrix seen through a shape u: u^H G u / |u|^2 at every line.
+Eigen::VectorXd projected_spectrum(const CrossSpectra& G, const Eigen::VectorXcd& u) {
+  const double uu = std::max(u.squaredNorm(), 1e-300);
+  Eigen::VectorXd out(G.frequency.size());
+  for (Eigen::Index k = 0; k < G.frequency.size(); ++k)
+    out[k] = std::max(u.dot(G.G[static_cast<std::size_t>(k)] * u).real(), 0.0) / uu;
+  return out;
 }
 
 // A cluster's shape: the weighted mean of its poles' shapes, each turned to the strongest member's phase.
@@ -577,16 +703,20 @@ IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationO
   // selected poles for the shapes.
   internal::select_modes(
       poles, in.lo, in.hi, o, s.background.cwiseAbs2(), decay,
-      [&](const internal::PoleCluster& c) { return lscf_cluster_shape(in, c, decay, s.resolution_hz); }, s);
-  lscf_mode_shapes(in, decay, s);
+      [&](const std::vector<internal::PoleCluster>& all, std::size_t c) {
+        return lscf_cluster_shape(in, all, c, decay, s.resolution_hz, internal::kShapedShare * o.min_cluster_fraction,
+                                  o.min_mpc);
+      },
+      [&](const Eigen::VectorXcd& u) { return projected_frf_power(frf_in, u); }, s);
+  lscf_final_modes(in, frf_in, decay, o, s);
   s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return s;
 }
 
-IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOptions& o) {
-  check_band(o);
-  const auto t0 = Clock::now();
-  rec.validate("SSI: " + rec.source);
+namespace {
+
+// SSI-cov over one band (the options' band; decimation and block rows from it).
+IdentificationSummary identify_ssi_band(const Recording& rec, const IdentificationOptions& o) {
   const SsiSetup u = ssi_setup(rec, o);
   IdentificationSummary s;
   s.method = "ssi";
@@ -595,14 +725,109 @@ IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOpt
   s.max_order = u.nmax;
   s.band_lo_hz = u.lo;
   s.band_hi_hz = u.hi;
-
   const std::vector<Eigen::MatrixXd> records = ssi_records(rec, u);
   const internal::OrderPoles poles = ssi_poles(ssi_toeplitz(records, u), u);
-  output_spectrum_indicator(records, u, o, s);
+  const CrossSpectra G = output_spectrum_indicator(records, u, o, s);
   internal::select_modes(
       poles, u.lo, u.hi, o, s.background, 0.0,
-      [&](const internal::PoleCluster& c) { return ssi_cluster_shape(poles, c); }, s);
+      [&](const std::vector<internal::PoleCluster>& all, std::size_t c) {
+        return internal::ClusterShape{ssi_cluster_shape(poles, all[c]), -1.0};
+      },
+      [&](const Eigen::VectorXcd& shape) { return projected_spectrum(G, shape); }, s);
   for (IdentifiedMode& m : s.modes) finish_shape(m);
+  return s;
+}
+
+// Sub-bands of a wide band (identify.hpp, identify_ssi): from the top down, each [hi / kSubBandSpan, hi], owning
+// [hi / 8, hi / 2] (the top one everything above hi / 8, the lowest everything below), the next one's top a
+// quarter of this one's; the lowest reaches down to `flow`.
+constexpr double kSubBandSpan = 16;
+struct SubBand {
+  double lo = 0, hi = 0, own_lo = 0, own_hi = 0;
+};
+std::vector<SubBand> ssi_sub_bands(double flow, double hi) {
+  std::vector<SubBand> out;
+  if (hi / flow <= kSubBandSpan) return {{flow, hi, 0, 1e300}};
+  for (double top = hi;; top /= 4) {
+    SubBand b{top / kSubBandSpan, top, top / 8, out.empty() ? 1e300 : top / 2};
+    if (b.lo <= 2 * flow) {
+      b.lo = std::min(b.lo, flow);
+      b.own_lo = 0;
+      out.push_back(b);
+      break;
+    }
+    out.push_back(b);
+  }
+  return out;
+}
+
+// Adds the modes, rejected clusters and diagram poles of a sub-band's summary t in [a, b) to s.
+void merge_sub_band(IdentificationSummary& s, const IdentificationSummary& t, double a, double b) {
+  std::vector<int> index(t.modes.size(), -1);
+  for (std::size_t k = 0; k < t.modes.size(); ++k)
+    if (t.modes[k].frequency_hz >= a && t.modes[k].frequency_hz < b) {
+      index[k] = static_cast<int>(s.modes.size());
+      s.modes.push_back(t.modes[k]);
+    }
+  for (const RejectedCluster& r : t.rejected)
+    if (r.frequency_hz >= a && r.frequency_hz < b) {
+      s.rejected.push_back(r);
+      if (r.merged_into >= 0) s.rejected.back().merged_into = index[static_cast<std::size_t>(r.merged_into)];
+    }
+  for (const StabilizationPole& p : t.poles)
+    if (p.frequency_hz >= a && p.frequency_hz < b) {
+      s.poles.push_back(p);
+      if (p.cluster >= 0) s.poles.back().cluster = index[static_cast<std::size_t>(p.cluster)];
+    }
+}
+
+}  // namespace
+
+IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOptions& o) {
+  check_band(o);
+  const auto t0 = Clock::now();
+  rec.validate("SSI: " + rec.source);
+  const SsiSetup u = ssi_setup(rec, o);
+  const std::vector<SubBand> bands =
+      o.decimate == 0 && o.block_rows == 0 ? ssi_sub_bands(u.flow, u.hi) : std::vector<SubBand>{{u.lo, u.hi, 0, 1e300}};
+  IdentificationSummary s;
+  if (bands.size() == 1) {
+    s = identify_ssi_band(rec, o);
+  } else {
+    // The top sub-band's summary carries the background; every sub-band gives the modes it owns.
+    for (std::size_t k = 0; k < bands.size(); ++k) {
+      IdentificationOptions ok = o;
+      ok.band_lo_hz = bands[k].lo;
+      ok.band_hi_hz = bands[k].hi;
+      IdentificationSummary t = identify_ssi_band(rec, ok);
+      if (k == 0) {
+        s = t;
+        s.modes.clear(), s.rejected.clear(), s.poles.clear();
+        s.band_lo_hz = u.lo;
+      }
+      merge_sub_band(s, t, bands[k].own_lo, bands[k].own_hi);
+    }
+    auto by_f = [](const auto& x, const auto& y) { return x.frequency_hz < y.frequency_hz; };
+    std::vector<std::size_t> order(s.modes.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t x, std::size_t y) { return by_f(s.modes[x], s.modes[y]); });
+    std::vector<int> rank(order.size());
+    std::vector<IdentifiedMode> modes;
+    for (std::size_t k = 0; k < order.size(); ++k)
+      rank[order[k]] = static_cast<int>(k), modes.push_back(s.modes[order[k]]);
+    s.modes = std::move(modes);
+    for (RejectedCluster& r : s.rejected)
+      if (r.merged_into >= 0) r.merged_into = rank[static_cast<std::size_t>(r.merged_into)];
+    for (StabilizationPole& p : s.poles)
+      if (p.cluster >= 0) p.cluster = rank[static_cast<std::size_t>(p.cluster)];
+    std::stable_sort(s.rejected.begin(), s.rejected.end(), by_f);
+    char b[200];
+    std::snprintf(b, sizeof b,
+                  "SSI in %zu sub-bands (each 1:%g, decimated to its top): the band %.4g-%.4g Hz spans 1:%.0f",
+                  bands.size(), kSubBandSpan, u.flow, u.hi, u.hi / u.flow);
+    s.notes.push_back(b);
+  }
   mark_twins(s.modes, false);
   s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return s;

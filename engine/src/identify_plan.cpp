@@ -141,6 +141,22 @@ double excitation_top(const Spectrum& q, double top) {
   return edge;
 }
 
+// Output-only records: the highest frequency up to `top` where the outputs' spectrum, averaged over 5 lines,
+// stands >= 10 dB above its floor (the 10th percentile of its levels up to `top`): where the response ends (the
+// excitation's band, or the modes the sensors see above the noise). Highly damped modes' peaks stand less than
+// 10 dB out, so the peaks' rule stops short of them.
+double response_top(const Spectrum& q, double top) {
+  std::vector<double> levels;
+  for (Eigen::Index k = 1; k < q.level.size(); ++k)
+    if (q.f[k] <= top) levels.push_back(q.level[k]);
+  if (levels.size() < 8) return 0;
+  const double floor = 10 * percentile(levels, 0.1);
+  double edge = 0;
+  for (Eigen::Index k = 3; k + 2 < q.level.size() && q.f[k] <= top; ++k)
+    if (q.level.segment(k - 2, 5).mean() >= floor) edge = q.f[k];
+  return edge;
+}
+
 int pow2_at_most(double n) {
   int p = 8;
   while (2.0 * p <= n) p *= 2;
@@ -169,10 +185,12 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
   int segment = p.impulsive ? 0 : pow2_at_most(static_cast<double>(shortest) / 8);
   if (!p.impulsive && segment < 64) segment = pow2_at_most(static_cast<double>(shortest));
   Spectrum sp = channel_spectrum(recs, p.impulsive, segment, false);
+  Spectrum hits;  // impacts: the hits' energy spectrum
   if (p.impulsive) {
     // Impacts: the outputs' energy over the hits' (a sum of |FRF|^2): the peaks of every mode the hits excite,
     // not only of those below the hits' spectral roll-off.
-    const Spectrum in = channel_spectrum(recs, true, segment, true);
+    hits = channel_spectrum(recs, true, segment, true);
+    const Spectrum& in = hits;
     if (in.level.size() == sp.level.size()) {
       const double tiny = std::max(1e-12 * in.level.maxCoeff(), 1e-300);  // lines the hits do not reach
       for (Eigen::Index k = 0; k < sp.level.size(); ++k) sp.level[k] /= std::max(in.level[k], tiny);
@@ -201,17 +219,26 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
     p.lowest_peak_hz = p.peaks_hz.front();
     p.lowest_peak_damping = widths.empty() ? 0 : widths.front() / (2 * p.lowest_peak_hz);
   }
-  // Band from the peaks, unless given; a measured broadband force shows where the excitation ends, and the top
-  // reaches it when the peaks' rule stops short of it (the highest modes' peaks stand less than 10 dB out).
+  // Band from the peaks, unless given; a measured broadband force (or the hits) shows where the excitation ends,
+  // and the top reaches it when the peaks' rule stops short of it (the highest modes' peaks stand less than 10 dB
+  // out, or overlap).
   if (o.band_hi_hz <= 0) {
     band_from_peaks(p, 0.45 * fs);
-    if (!p.impulsive && any_input && p.band_from_data) {
-      const double edge = excitation_top(channel_spectrum(recs, false, segment, true), 0.45 * fs);
+    if (any_input && p.band_from_data) {
+      const double edge = excitation_top(p.impulsive ? hits : channel_spectrum(recs, false, segment, true), 0.45 * fs);
       if (edge > p.band_hi_hz) {
         p.band_hi_hz = edge;
         char b[160];
         std::snprintf(b, sizeof b,
                       "band top %.4g Hz: where the measured force's spectrum ends (10 dB below its median)", edge);
+        p.notes.push_back(b);
+      }
+    } else if (!p.impulsive && p.band_from_data) {
+      const double edge = response_top(sp, 0.45 * fs);
+      if (edge > p.band_hi_hz) {
+        p.band_hi_hz = edge;
+        char b[160];
+        std::snprintf(b, sizeof b, "band top %.4g Hz: where the outputs' spectrum ends (10 dB above its floor)", edge);
         p.notes.push_back(b);
       }
     }

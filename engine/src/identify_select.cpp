@@ -65,27 +65,34 @@ std::vector<Cand> weighted_poles(const std::vector<std::vector<RawPole>>& orders
       sp.damping_ratio = pole_zeta(rp.lambda);
       sp.physical = sp.frequency_hz >= lo && sp.frequency_hz <= hi && sp.damping_ratio > 0 && sp.damping_ratio < o.max_damping;
       if (j > 0 && !orders[j - 1].empty()) {
-        const RawPole* best = nullptr;
-        double bd = 1e300;
+        // The pole of the previous order it continues: the one it matches best in frequency, damping and vector
+        // (the stability weight's maximum over them; the nearest in frequency when it matches none). Of a closely
+        // spaced pair, the nearest in frequency may be the other mode's pole.
+        const double edge = 0.01 * sp.frequency_hz;
+        const double phys = sp.frequency_hz > 0 && sp.damping_ratio > 0
+                                ? std::clamp((o.max_damping - sp.damping_ratio) / (0.25 * o.max_damping), 0.0, 1.0) *
+                                      std::clamp((sp.frequency_hz - lo) / edge + 0.5, 0.0, 1.0) *
+                                      std::clamp((hi - sp.frequency_hz) / edge + 0.5, 0.0, 1.0)
+                                : 0.0;
+        struct Match {
+          double df = 1e300, dz = 0, mac = 0, w = 0;
+        } best, nearest;
         for (const RawPole& q : orders[j - 1]) {
-          const double d = std::abs(pole_hz(q.lambda) - sp.frequency_hz);
-          if (d < bd) bd = d, best = &q;
+          Match m;
+          m.df = std::abs(pole_hz(q.lambda) - sp.frequency_hz) / sp.frequency_hz;
+          m.dz = std::abs(pole_zeta(q.lambda) - sp.damping_ratio) / std::max(std::abs(sp.damping_ratio), 1e-12);
+          m.mac = rp.vec.size() <= 1 ? 1.0 : complex_mac(rp.vec, q.vec);
+          m.w = phys * ramp(m.df / o.stable_frequency) * ramp(m.dz / o.cluster_damping) *
+                ramp((1 - m.mac) / std::max(1 - o.stable_mac, 1e-12));
+          if (m.w > best.w) best = m;
+          if (m.df < nearest.df) nearest = m;
         }
-        const double zq = pole_zeta(best->lambda);
-        const double df = bd / sp.frequency_hz;
-        sp.damping_change = std::abs(zq - sp.damping_ratio) / std::max(std::abs(sp.damping_ratio), 1e-12);
-        const double mac = rp.vec.size() <= 1 ? 1.0 : complex_mac(rp.vec, best->vec);
-        sp.stable_frequency = df <= o.stable_frequency;
-        sp.stable_damping = sp.damping_change <= o.stable_damping;
-        sp.stable_vector = mac >= o.stable_mac;
-        if (sp.frequency_hz > 0 && sp.damping_ratio > 0) {
-          // Soft physical limits: damping towards max_damping, frequency towards the band edges (1 % of f).
-          const double edge = 0.01 * sp.frequency_hz;
-          const double phys = std::clamp((o.max_damping - sp.damping_ratio) / (0.25 * o.max_damping), 0.0, 1.0) *
-                              std::clamp((sp.frequency_hz - lo) / edge + 0.5, 0.0, 1.0) * std::clamp((hi - sp.frequency_hz) / edge + 0.5, 0.0, 1.0);
-          sp.weight = phys * ramp(df / o.stable_frequency) * ramp(sp.damping_change / o.cluster_damping) *
-                      ramp((1 - mac) / std::max(1 - o.stable_mac, 1e-12));
-        }
+        const Match& m = best.w > 0 ? best : nearest;
+        sp.weight = best.w;
+        sp.damping_change = m.dz;
+        sp.stable_frequency = m.df <= o.stable_frequency;
+        sp.stable_damping = m.dz <= o.stable_damping;
+        sp.stable_vector = m.mac >= o.stable_mac;
       }
       if (sp.weight > 0)
         cand.push_back({static_cast<int>(s.poles.size()), static_cast<int>(j), static_cast<int>(p), sp.frequency_hz, sp.weight});
@@ -139,21 +146,58 @@ std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<Raw
     centres.push_back(sw > 0 ? swf / sw : tops[a].first);
     a = b;
   }
-  // Each candidate supports the centre it is nearest to (relative distance); per order the best one counts.
+  // Each candidate supports the centre it is nearest to (relative distance).
   const std::size_t nc = centres.size();
-  std::vector<std::map<int, std::pair<double, std::size_t>>> best(nc);  // centre -> order -> (weight, cand)
+  std::vector<std::vector<std::pair<double, std::size_t>>> members(nc);  // centre -> (weight, cand)
   for (std::size_t a = 0; a < cand.size(); ++a) {
     const auto it = std::lower_bound(centres.begin(), centres.end(), cand[a].f);
     std::size_t c = static_cast<std::size_t>(it - centres.begin());
     if (c == nc || (c > 0 && std::abs(cand[a].f - centres[c - 1]) / centres[c - 1] < std::abs(centres[c] - cand[a].f) / centres[c])) --c;
     const double k = cand[a].w * window(std::abs(cand[a].f - centres[c]) / (tol * centres[c]));
-    if (k <= 0) continue;
-    auto& slot = best[c][cand[a].j];
-    if (k > slot.first) slot = {k, a};
+    if (k > 0) members[c].emplace_back(k, a);
+  }
+  // Shape families within a centre: the poles of the two modes of a closely spaced pair share one window, and
+  // their vectors tell them apart. Strongest first, each pole joins the family whose mean vector it is most like,
+  // fully from a MAC of cluster_mac, with a share falling to 0 at 2 cluster_mac - 1 (below the middle it starts
+  // a family of its own). Scalar vectors (LSCF with one input) make one family. Per family and order the best
+  // pole counts.
+  std::vector<std::map<int, std::pair<double, std::size_t>>> best;  // cluster -> order -> (weight, cand)
+  for (std::size_t c = 0; c < nc; ++c) {
+    std::stable_sort(members[c].begin(), members[c].end(),
+                     [](const auto& x, const auto& y) { return x.first > y.first; });
+    std::vector<Eigen::VectorXcd> mean;  // per family, the weighted sum of its aligned unit vectors
+    const std::size_t first = best.size();
+    for (const auto& [k, a] : members[c]) {
+      const Eigen::VectorXcd& v0 = orders[static_cast<std::size_t>(cand[a].j)][static_cast<std::size_t>(cand[a].p)].vec;
+      std::size_t f = 0;
+      double like = 1;
+      if (v0.size() > 1 && v0.norm() > 0) {
+        Eigen::VectorXcd v = v0.normalized();
+        double mac = -1;
+        for (std::size_t q = 0; q < mean.size(); ++q) {
+          const double m = complex_mac(v, mean[q]);
+          if (m > mac) mac = m, f = q;
+        }
+        like = mac < 0 ? 0 : ramp((1 - mac) / std::max(1 - o.cluster_mac, 1e-12));
+        if (like < 0.5) {
+          f = mean.size(), like = 1;
+          mean.push_back(Eigen::VectorXcd::Zero(v.size()));
+          best.emplace_back();
+        }
+        const std::complex<double> d = mean[f].dot(v);  // conj(mean) . v
+        if (std::abs(d) > 0) v *= std::conj(d) / std::abs(d);
+        mean[f] += k * like * v;
+      } else if (best.size() == first) {
+        mean.emplace_back();
+        best.emplace_back();
+      }
+      auto& slot = best[first + f][cand[a].j];
+      if (k * like > slot.first) slot = {k * like, a};
+    }
   }
   std::vector<PoleCluster> out;
   const double n_orders = static_cast<double>(orders.size());
-  for (std::size_t c = 0; c < nc; ++c) {
+  for (std::size_t c = 0; c < best.size(); ++c) {
     if (best[c].size() < 2) continue;
     PoleCluster pc;
     double sw = 0, sf = 0, sz = 0;
@@ -180,6 +224,8 @@ std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<Raw
     pc.damping_std = std::sqrt(vz / sw);
     out.push_back(std::move(pc));
   }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const PoleCluster& x, const PoleCluster& y) { return x.frequency_hz < y.frequency_hz; });
   return out;
 }
 
@@ -239,6 +285,20 @@ double indicator_dip_db(const Eigen::VectorXd& f, const Eigen::VectorXd& ind, do
   return top - low;
 }
 
+bool is_split(const SplitSide& c, const SplitSide& h, double h_peak_db, const Eigen::VectorXd& frequency_hz,
+              const Eigen::VectorXd& h_indicator, const IdentificationOptions& o) {
+  const double tol = std::max(o.merge_tolerance, std::max(c.damping_ratio, h.damping_ratio));
+  const double apart = std::abs(c.frequency_hz - h.frequency_hz);
+  // Within the half-power window, or beyond it on the flank of the stronger one's indicator peak; never with a dip
+  // of the indicator between them (two peaks: two modes, whose local shapes may look alike).
+  if (apart > o.merge_span * h.frequency_hz) return false;
+  if (apart > tol * h.frequency_hz && h_peak_db < o.min_peak_db) return false;
+  const double smooth = 0.5 * std::min(c.damping_ratio * c.frequency_hz, h.damping_ratio * h.frequency_hz);
+  if (indicator_dip_db(frequency_hz, h_indicator, c.frequency_hz, h.frequency_hz, smooth) >= o.min_peak_db)
+    return false;
+  return complex_mac(c.shape, h.shape) >= o.merge_mac;
+}
+
 namespace {
 // Support of several clusters together: per order the best weight of any of them.
 double joint_support(const std::vector<Candidate>& cands, const std::vector<std::size_t>& group, std::size_t n_orders) {
@@ -258,8 +318,9 @@ double joint_support(const std::vector<Candidate>& cands, const std::vector<std:
 
 std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& cands,
                                                      const std::vector<IndicatorEvidence>& ev,
-                                                     const Eigen::VectorXd& indicator, const IdentificationOptions& o,
-                                                     std::size_t n_orders, IdentificationSummary& s) {
+                                                     const std::vector<Eigen::VectorXd>& indicators,
+                                                     const IdentificationOptions& o, std::size_t n_orders,
+                                                     IdentificationSummary& s) {
   auto reject = [&](const PoleCluster& c, Rejection r, double value, double limit, int into = -1) {
     RejectedCluster rc;
     rc.frequency_hz = c.frequency_hz;
@@ -288,16 +349,9 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
     int into = -1;
     for (std::size_t g = 0; g < groups.size() && into < 0; ++g) {
       const PoleCluster& h = cands[groups[g][0]].cluster;
-      const double tol = std::max(o.merge_tolerance, std::max(c.damping_ratio, h.damping_ratio));
-      const double apart = std::abs(c.frequency_hz - h.frequency_hz);
-      // Within the half-power window, or beyond it on the flank of the stronger one's indicator peak; never with
-      // a dip of the indicator between them (two peaks: two modes, whose local shapes may look alike).
-      if (apart > o.merge_span * h.frequency_hz) continue;
-      if (apart > tol * h.frequency_hz && ev[groups[g][0]].peak_db < o.min_peak_db) continue;
-      const double smooth = 0.5 * std::min(c.damping_ratio * c.frequency_hz, h.damping_ratio * h.frequency_hz);
-      if (indicator_dip_db(s.frequency_hz, indicator, c.frequency_hz, h.frequency_hz, smooth) >= o.min_peak_db)
-        continue;
-      if (complex_mac(sk, head_shape[g]) >= o.merge_mac) into = static_cast<int>(g);
+      if (is_split({c.frequency_hz, c.damping_ratio, sk}, {h.frequency_hz, h.damping_ratio, head_shape[g]},
+                   ev[groups[g][0]].peak_db, s.frequency_hz, indicators[groups[g][0]], o))
+        into = static_cast<int>(g);
     }
     if (into < 0) {
       groups.push_back({k});
@@ -363,20 +417,27 @@ void make_modes(const std::vector<Candidate>& cands, const std::vector<Indicator
 }
 
 void select_modes(const OrderPoles& op, double lo, double hi, const IdentificationOptions& o,
-                  const Eigen::VectorXd& indicator, double decay,
-                  const std::function<Eigen::VectorXcd(const PoleCluster&)>& shape_of, IdentificationSummary& s) {
+                  const Eigen::VectorXd& indicator, double decay, const ShapeOf& shape_of,
+                  const IndicatorOf& indicator_of, IdentificationSummary& s) {
   const std::vector<PoleCluster> clusters = stabilize_and_cluster(op.poles, op.order, lo, hi, o, s);
   std::vector<Candidate> cands(clusters.size());
   std::vector<IndicatorEvidence> peak(clusters.size());
+  std::vector<Eigen::VectorXd> own(clusters.size());
   for (std::size_t c = 0; c < clusters.size(); ++c) {
     cands[c].cluster = clusters[c];
     cands[c].strength = clusters[c].support;
+    if (clusters[c].support >= kShapedShare * o.min_cluster_fraction) {
+      const ClusterShape cs = shape_of(clusters, c);
+      cands[c].shape = cs.shape;
+      if (cs.strength >= 0) cands[c].strength = cs.strength;
+      own[c] = indicator_of(cands[c].shape);
+    } else {
+      own[c] = indicator;
+    }
     const double zw = clusters[c].damping_ratio + decay / (2 * kPi * clusters[c].frequency_hz);
-    peak[c] = indicator_evidence(s.frequency_hz, indicator, clusters[c].frequency_hz, zw);
-    if (clusters[c].support < kShapedShare * o.min_cluster_fraction) continue;
-    cands[c].shape = shape_of(clusters[c]);
+    peak[c] = indicator_evidence(s.frequency_hz, own[c], clusters[c].frequency_hz, zw);
   }
-  make_modes(cands, peak, check_evidence(cands, peak, indicator, o, op.poles.size(), s), op.poles.size(), s);
+  make_modes(cands, peak, check_evidence(cands, peak, own, o, op.poles.size(), s), op.poles.size(), s);
 }
 
 }  // namespace dynid::internal

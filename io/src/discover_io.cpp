@@ -1,6 +1,7 @@
 #include "dynid/io/discover_io.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <set>
 
@@ -11,6 +12,8 @@
 namespace dynid {
 
 namespace {
+
+std::vector<double> vec(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
 
 bool shares(const std::vector<int>& have, const std::vector<int>& want) {
   for (int w : want)
@@ -35,11 +38,9 @@ double stiffness_reference(const DiscoverSpec::Expect& e, const Site& site, cons
   for (int id : site.elements) {
     const int k = model.element_index(id);
     if (k < 0) return e.value;
-    const Element& el = model.elements()[static_cast<std::size_t>(k)];
-    if (el.num_nodes != 2) return e.value;
-    const double L = (model.nodes()[static_cast<std::size_t>(model.node_index(el.node_ids[1]))].x -
-                      model.nodes()[static_cast<std::size_t>(model.node_index(el.node_ids[0]))].x)
-                         .norm();
+    const std::array<int, 2>& n = model.element_nodes(k);
+    if (n[0] < 0 || n[1] < 0) return e.value;
+    const double L = (model.nodes()[n[1]].x - model.nodes()[n[0]].x).norm();
     const bool hit = std::find(e.elements.begin(), e.elements.end(), id) != e.elements.end();
     flex += L * (1 / (1 + (hit ? e.value : 0.0) / 100) - 1);
     total += L;
@@ -119,9 +120,9 @@ nlohmann::ordered_json quality_json(const FitQuality& q) {
   j["unpaired_modes"] = q.unpaired;
   j["mean_mac"] = q.mean_mac;
   j["chi2"] = q.chi2;
-  j["measured_hz"] = std::vector<double>(q.measured_hz.data(), q.measured_hz.data() + q.measured_hz.size());
-  j["model_hz"] = std::vector<double>(q.model_hz.data(), q.model_hz.data() + q.model_hz.size());
-  j["mac"] = std::vector<double>(q.mac.data(), q.mac.data() + q.mac.size());
+  j["measured_hz"] = vec(q.measured_hz);
+  j["model_hz"] = vec(q.model_hz);
+  j["mac"] = vec(q.mac);
   return j;
 }
 
@@ -395,6 +396,9 @@ nlohmann::ordered_json discovery_json(const Case& c, const DiscoveryData& d, con
   auto source = [](NoiseModel::Source x) { return x == NoiseModel::Source::kStated ? "stated" : x == NoiseModel::Source::kData ? "data" : "default"; };
   j["noise"] = {{"frequency", s.noise.frequency}, {"frequency_source", source(s.noise.frequency_source)},
                 {"shape", s.noise.shape}, {"shape_source", source(s.noise.shape_source)}, {"scale_frequency", s.noise_scale_frequency}, {"scale_shape", s.noise_scale_shape}};
+  // Per measured mode used: the frequency noise and its discretization part (relative; empty when not per mode).
+  j["noise"]["frequency_modes"] = vec(s.noise.frequency_modes);
+  j["noise"]["discretization"] = vec(s.noise.discretization);
   j["set_aside"] = nlohmann::ordered_json::array();
   for (const SetAside& a : s.set_aside)
     j["set_aside"].push_back({{"mode", a.mode + 1}, {"frequency_hz", a.frequency_hz},

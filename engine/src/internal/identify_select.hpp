@@ -65,11 +65,22 @@ IndicatorEvidence indicator_evidence(const Eigen::VectorXd& frequency_hz, const 
 double indicator_dip_db(const Eigen::VectorXd& frequency_hz, const Eigen::VectorXd& indicator, double fa, double fb,
                         double smooth_hz);
 
+/// The split rule (identify.hpp, step 3): a weaker mode c is a split of a stronger one h when their shapes
+/// (real-normalised) have a MAC >= merge_mac, within max(merge_tolerance, zeta) in frequency, or within merge_span
+/// with h's indicator peak standing (h_peak_db >= min_peak_db), and h's indicator nowhere dips min_peak_db between
+/// them. Damping ratios as the indicator sees them (an exponential window's decay included).
+struct SplitSide {
+  double frequency_hz = 0, damping_ratio = 0;
+  Eigen::VectorXcd shape;
+};
+bool is_split(const SplitSide& c, const SplitSide& h, double h_peak_db, const Eigen::VectorXd& frequency_hz,
+              const Eigen::VectorXd& h_indicator, const IdentificationOptions& o);
+
 /// A cluster with its shape, for the evidence checks.
 struct Candidate {
   PoleCluster cluster;
   Eigen::VectorXcd shape;
-  double strength = 0;  ///< which of two splits is the stronger (support)
+  double strength = 0;  ///< which of two splits is the stronger (ClusterShape::strength, else support)
 };
 
 /// Step 3: the checks, on candidates with shapes (those without one, below the shaping limit, are rejected for
@@ -78,24 +89,42 @@ struct Candidate {
 /// checked: joint support, MPC and mode indicator of its strongest cluster.
 /// Returns the accepted modes, ascending in frequency, each as its strongest candidate followed by the splits
 /// merged into it; appends every rejected candidate to s.rejected. `evidence` gives each candidate's
-/// indicator_evidence; `n_orders` the number of model orders.
+/// indicator_evidence on its own mode indicator `indicators` (on s.frequency_hz; the dip between two clusters is
+/// read on the stronger one's); `n_orders` the number of model orders.
 std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& candidates,
                                                      const std::vector<IndicatorEvidence>& evidence,
-                                                     const Eigen::VectorXd& indicator, const IdentificationOptions& o,
-                                                     std::size_t n_orders, IdentificationSummary& s);
+                                                     const std::vector<Eigen::VectorXd>& indicators,
+                                                     const IdentificationOptions& o, std::size_t n_orders,
+                                                     IdentificationSummary& s);
 
 /// The accepted modes as IdentifiedModes (frequency, damping, spreads and shape of the strongest cluster, the
 /// joint support of all), and the diagram's poles marked with their mode.
 void make_modes(const std::vector<Candidate>& candidates, const std::vector<IndicatorEvidence>& evidence, const std::vector<std::vector<std::size_t>>& accepted,
                 std::size_t n_orders, IdentificationSummary& s);
 
-/// Steps 1-3 on the poles of every order: the diagram and clusters in [lo, hi], each cluster's indicator
-/// evidence on `indicator` (a power-like mode indicator on s.frequency_hz; the cluster's damping widened by an
-/// exponential window's `decay`), a shape from `shape_of` for the clusters with enough support to be checked,
-/// the checks, and s.modes (shapes as given, before any final re-estimation).
+/// A cluster's shape (complex, at the outputs), given every cluster (LSCF fits it with its neighbours' poles),
+/// and its strength when the method measures one (< 0: its support): of two clusters of one mode (a split), the
+/// stronger one is the mode. LSCF: the peak amplitude of its residues, |R| / (zeta w) (a pole fitting a stronger
+/// neighbour's residual error has a small residue, however stable it is).
+struct ClusterShape {
+  Eigen::VectorXcd shape;
+  double strength = -1;
+};
+using ShapeOf = std::function<ClusterShape(const std::vector<PoleCluster>& clusters, std::size_t c)>;
+/// The mode indicator seen through a shape u, power-like on s.frequency_hz: the output spectral matrix's
+/// u^H G u / |u|^2 (SSI) or the FRFs' |u^H H|^2 / |u|^2 summed over the inputs (LSCF). A mode whose shape differs
+/// from its neighbours' (the other mode of a closely spaced pair) shows its own peak there, where the first
+/// singular value shows the stronger mode's flank.
+using IndicatorOf = std::function<Eigen::VectorXd(const Eigen::VectorXcd& u)>;
+
+/// Steps 1-3 on the poles of every order: the diagram and clusters in [lo, hi], a shape from `shape_of` for the
+/// clusters with enough support to be checked and their mode indicator through it (`indicator_of`; `indicator`,
+/// power-like on s.frequency_hz, for the others), each cluster's indicator evidence (the cluster's damping widened
+/// by an exponential window's `decay`), the checks, and s.modes (shapes as given, before any final
+/// re-estimation).
 void select_modes(const OrderPoles& poles, double lo, double hi, const IdentificationOptions& o,
-                  const Eigen::VectorXd& indicator, double decay,
-                  const std::function<Eigen::VectorXcd(const PoleCluster&)>& shape_of, IdentificationSummary& s);
+                  const Eigen::VectorXd& indicator, double decay, const ShapeOf& shape_of,
+                  const IndicatorOf& indicator_of, IdentificationSummary& s);
 
 /// Clusters with at least this share of min_cluster_fraction get a shape and the evidence checks (weaker ones
 /// are rejected for their support without one).

@@ -4,19 +4,27 @@
 // Both run over a range of model orders, build a stabilization diagram (each pole marked stable in frequency,
 // damping and vector against the nearest pole of the previous order), and select modes automatically:
 //   1. Each physical pole gets a stability weight in [0, 1]: 1 while its frequency, damping and vector changes
-//      against the previous order are within the tolerances below, falling linearly to 0 at twice them. The
-//      weight is continuous in the poles, so rounding (another thread count, another BLAS) moves it by rounding,
-//      never from 0 to 1: no selection decision below hinges on one pole crossing a threshold.
+//      against the pole of the previous order it continues are within the tolerances below, falling linearly to
+//      0 at twice them (the weight is the largest over the previous order's poles: of a closely spaced pair, the
+//      nearest pole in frequency may be the other mode's). The weight is continuous in the poles, so rounding
+//      (another thread count, another BLAS) moves it by rounding, never from 0 to 1: no selection decision below
+//      hinges on one pole crossing a threshold.
 //   2. Clusters: the pole frequencies are grouped around the maxima of their weighted density (mean shift with
-//      a window of +-cluster_tolerance, relative); a cluster's support is the sum over the orders of the weight
-//      of the order's best pole in the window (the window's edge weighs 0), divided by the number of orders.
+//      a window of +-cluster_tolerance, relative); within a window, poles whose vectors differ (MAC below
+//      cluster_mac; a share of their weight down to 2 cluster_mac - 1) form separate clusters: the two modes of a
+//      closely spaced pair, both present over the orders. A cluster's support is the sum over the orders of the
+//      weight of the order's best pole (the window's edge weighs 0), divided by the number of orders.
 //      Its frequency and damping are the support-weighted means of those poles; their weighted standard
 //      deviations are the spread over orders.
-//   3. Evidence, each a reason to reject a cluster (listed in IdentificationSummary::rejected):
+//   3. Evidence, each a reason to reject a cluster (listed in IdentificationSummary::rejected). Each cluster's
+//      shape is judged as estimated beside its neighbours (LSCF: residues from the lines around it, fitted with
+//      the poles of the clusters near it, so that each of a close pair gets its own; its pole alone when that joint
+//      fit leaves the shape complex and the alone fit does not), and its mode indicator is
+//      seen through that shape (the FRFs' |u^H H|^2, the output spectra's u^H G u), where the weaker mode of a
+//      close pair has its own peak:
 //        support below min_cluster_fraction (not stable over enough orders);
 //        shape: MPC below min_mpc (not a normal mode: noise or a mathematical pole);
-//        mode indicator (CMIF for FRFs, the first singular value of the output spectral matrix for output-only
-//          data) less than min_peak_db above the straight line (in dB) between its values one half-power
+//        mode indicator less than min_peak_db above the straight line (in dB) between its values one half-power
 //          bandwidth either side (w = max(2 zeta f, 2 line spacings)): no peak of its own there (a mode the
 //          sensors barely see, whose shape is noise, or a pole in a trough or on the flank of another mode);
 //        a spectral edge: the indicator falls from f to f -+ w more than max_edge_db further than the pole's own
@@ -28,7 +36,8 @@
 //          the lower of their levels; a dip means two modes, whose local shapes may look alike): one physical
 //          mode whose poles drifted over orders, or a second report of it. Splits
 //          are merged before the other checks: the group's support counts, per order, its best pole; its
-//          frequency, damping and shape are the strongest cluster's.
+//          frequency, damping and shape are the strongest cluster's (LSCF: the largest peak amplitude of its
+//          residues, a pole fitting a neighbour's residual error has a small one; SSI: the best support).
 // Uncertainty: the spread over orders understates the scatter of a mode from one data set to the next. With
 // recordings (identify_recordings), the two halves of the data (records, or the two halves in time of one
 // record) are identified again with the same settings; halves' modes are paired with the full data's by MAC;
@@ -65,6 +74,7 @@ struct IdentificationOptions {
   double max_damping = 0.2;         ///< poles with zeta outside (0, max_damping) are not physical
   double min_cluster_fraction = 0.45; ///< support a cluster needs (weighted share of the orders)
   double cluster_tolerance = 0.01;    ///< half-width of a cluster's window (relative frequency)
+  double cluster_mac = 0.9;           ///< poles support one cluster only with vectors this alike (MAC)
   // Evidence a cluster needs to be reported as a mode (see the header comment).
   double min_mpc = 0.5;             ///< modal phase collinearity of its shape
   double min_peak_db = 3;           ///< how far above its surroundings the mode indicator must stand
@@ -167,9 +177,10 @@ struct IdentificationSummary {
 /// hits' spectral roll-off show their peaks too).
 ///   band: [0.5 x lowest peak, min(1.25 x highest peak, 0.45 x sampling rate)], over the peaks that stand
 ///         >= 10 dB above their surroundings (prominence) and >= 10 dB above the spectrum's 10th-percentile
-///         level (the noise floor); the whole range below 0.45 fs when there is none. Continuous records with a
-///         measured force: the top reaches where the force's spectrum ends (the highest line within 10 dB of its
-///         median level), when the peaks' rule stops below it (the highest modes' peaks stand out less).
+///         level (the noise floor); the whole range below 0.45 fs when there is none. Records with a measured
+///         force (continuous or hits): the top reaches where the force's spectrum ends (the highest line within
+///         10 dB of its median level), when the peaks' rule stops below it (the highest modes' peaks stand out
+///         less, or overlap).
 ///   resolution (continuous records): the lowest peak's half-power bandwidth 2 zeta f (zeta from the -3 dB
 ///         width, refined with longer segments while the width spans fewer than 4 lines) spans 4 lines:
 ///         segment = fs / (zeta f / 2), a power of two, at most a quarter of the shortest record (>= 7
