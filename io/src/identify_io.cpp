@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include "dynid/io/modal_data_io.hpp"
+#include "internal/json_util.hpp"
 
 namespace dynid {
 
@@ -41,8 +42,8 @@ nlohmann::ordered_json identification_json(const IdentificationSummary& s) {
     poles.push_back({p.order, p.frequency_hz, p.damping_ratio, cls, p.cluster + 1});
   }
   j["stabilization"] = {{"poles", poles},
-                        {"frequency_hz", std::vector<double>(s.frequency_hz.data(), s.frequency_hz.data() + s.frequency_hz.size())},
-                        {"background", std::vector<double>(s.background.data(), s.background.data() + s.background.size())},
+                        {"frequency_hz", internal::vec(s.frequency_hz)},
+                        {"background", internal::vec(s.background)},
                         {"background_label", s.background_label}};
   nlohmann::ordered_json rejected = nlohmann::ordered_json::array();
   for (const RejectedCluster& r : s.rejected) {
