@@ -159,6 +159,79 @@ TEST(Discovery, FlexibleBaseMatchesAnExplicitSpring) {
   EXPECT_EQ(s.findings.size(), 1u) << said(s);
 }
 
+// The same flexible base, stage by stage (engine/src/discovery/stages.hpp): what each stage hands the next. The
+// screen's linearised drop must already rank the spring at node 2 first among the local candidates (the data are
+// exact, so nothing but the physics orders them), the shortlist must keep it, its own fit must remove nearly all
+// the misfit (1e-2 of chi2_0: the truth's released rotation carries mass that the candidate condenses statically),
+// and select() must start from it and stop there.
+TEST(DiscoveryStages, FlexibleBaseThroughEachStage) {
+  const Model analysis = make_frame2d(portal());
+  Model truth;
+  {
+    const Model base = make_frame2d(portal());
+    for (const Node& n : base.nodes()) truth.add_node(n.id, n.x);
+    for (const Material& m : base.materials()) truth.add_material(m);
+    for (const Section& s : base.sections()) truth.add_section(s);
+    for (const Element& e : base.elements()) truth.add_element(e);
+  }
+  Element sp;
+  sp.id = 9001;
+  sp.type = ElementType::Spring;
+  sp.num_nodes = 1;
+  sp.node_ids = {{2, 2}};
+  sp.spring_dofs = dof_bit(Dof::RZ);
+  sp.stiffness = 6.0e6;
+  truth.add_element(sp);
+  for (int id : {1, 3}) truth.restrain(id, kAllDofs);
+  truth.restrain(2, dof_bit(Dof::UX) | dof_bit(Dof::UY));
+  truth.finalize();
+  const ModalData meas = exact_modes(truth, analysis, 6);
+
+  internal::Problem p;
+  DiscoverySummary S;
+  internal::prepare(analysis, meas, DiscoveryOptions{}, {}, &p, &S);
+  ASSERT_EQ(p.modes, 6);
+  const auto at_node_2 = [](const Candidate& c) {
+    return c.kind() == "flexible_support" && c.site().nodes == std::vector<int>{2};
+  };
+
+  const Localization L = internal::locate(p);
+  ASSERT_FALSE(L.nodes.empty());
+  const internal::Screening sc = internal::screen(p);
+  EXPECT_GT(sc.chi2, 0.0);
+  int best = -1;
+  for (int k = 0; k < static_cast<int>(p.library.size()); ++k)
+    if (!p.library[k]->global() && (best < 0 || sc.drop[k] > sc.drop[best])) best = k;
+  ASSERT_GE(best, 0);
+  EXPECT_TRUE(at_node_2(*p.library[best])) << "screen ranks first: " << p.library[best]->description();
+
+  // The base spring can be modelled through either member at node 2; the screen's choice is the one to follow.
+  const int spring = best;
+  const std::vector<int> list = internal::shortlist(p, sc, L);
+  ASSERT_NE(std::find(list.begin(), list.end(), spring), list.end()) << "the shortlist lost the spring at node 2";
+
+  p.n = p.modes * (1 + static_cast<int>(p.data.dofs.size()));
+  p.chi2_0 = sc.chi2;
+  p.chi2_0_frequency = sc.chi2_frequency;
+  std::vector<internal::SetFit> singles;
+  for (int k : list) singles.push_back(internal::fit_set(p, {p.library[k].get()}));
+  const internal::SetFit* own = nullptr;
+  for (const internal::SetFit& f : singles)
+    if (f.set[0] == p.library[spring].get()) own = &f;
+  ASSERT_NE(own, nullptr);
+  ASSERT_TRUE(own->ok);
+  EXPECT_LT(own->chi2, 1e-2 * p.chi2_0) << own->chi2 << " of " << p.chi2_0;
+
+  std::vector<char> forced(sc.paired.size());
+  for (std::size_t k = 0; k < sc.paired.size(); ++k) forced[k] = !sc.paired[k];
+  const internal::Selection sel = internal::select(p, singles, internal::quality_of(p, sc.model_hz, sc.mac, sc.chi2, forced));
+  ASSERT_EQ(sel.fit.set.size(), 1u);
+  EXPECT_TRUE(at_node_2(*sel.fit.set[0])) << sel.fit.set[0]->description();
+  ASSERT_FALSE(sel.steps.empty());
+  EXPECT_EQ(sel.steps[0].action, SelectionStep::Action::kStart);
+  EXPECT_EQ(sel.importance.size(), 1u);
+}
+
 // Nothing missing: the data are the analysis model's own modes.
 TEST(Discovery, ExactDataOfTheModelIsConsistent) {
   const Model analysis = make_frame2d(portal());
