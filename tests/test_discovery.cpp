@@ -224,7 +224,8 @@ TEST(DiscoveryStages, FlexibleBaseThroughEachStage) {
 
   std::vector<char> forced(sc.paired.size());
   for (std::size_t k = 0; k < sc.paired.size(); ++k) forced[k] = !sc.paired[k];
-  const internal::Selection sel = internal::select(p, singles, internal::quality_of(p, sc.model_hz, sc.mac, sc.chi2, forced));
+  const internal::Selection sel =
+      internal::select(p, singles, internal::quality_of(p, sc.model_hz, sc.mac, sc.chi2, forced));
   ASSERT_EQ(sel.fit.set.size(), 1u);
   EXPECT_TRUE(at_node_2(*sel.fit.set[0])) << sel.fit.set[0]->description();
   ASSERT_FALSE(sel.steps.empty());

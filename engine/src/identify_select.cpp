@@ -168,9 +168,8 @@ using OrderBest = std::map<int, std::pair<double, std::size_t>>;  // order -> (w
 // fully from a MAC of cluster_mac, with a share falling to 0 at 2 cluster_mac - 1 (below the middle it starts
 // a family of its own). Scalar vectors (LSCF with one input) make one family. Per family and order the best
 // pole counts.
-std::vector<OrderBest> shape_families(Members members,
-                                      const std::vector<Cand>& cand, const std::vector<std::vector<RawPole>>& orders,
-                                      const IdentificationOptions& o) {
+std::vector<OrderBest> shape_families(Members members, const std::vector<Cand>& cand,
+                                      const std::vector<std::vector<RawPole>>& orders, const IdentificationOptions& o) {
   const std::size_t nc = members.size();
   std::vector<OrderBest> best;  // per family
   for (std::size_t c = 0; c < nc; ++c) {
@@ -211,8 +210,8 @@ std::vector<OrderBest> shape_families(Members members,
 
 // A cluster of each family with poles at two orders or more: support, weighted frequency and damping and their
 // spreads. Sorted by frequency.
-std::vector<PoleCluster> clusters_of(const std::vector<OrderBest>& best, const std::vector<Cand>& cand,
-                                     double n_orders, const IdentificationSummary& s) {
+std::vector<PoleCluster> clusters_of(const std::vector<OrderBest>& best, const std::vector<Cand>& cand, double n_orders,
+                                     const IdentificationSummary& s) {
   std::vector<PoleCluster> out;
   for (std::size_t c = 0; c < best.size(); ++c) {
     if (best[c].size() < 2) continue;

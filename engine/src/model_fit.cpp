@@ -755,7 +755,8 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
     n = 0;
     for (const Eigen::VectorXd& r : ef.r) out.final_residuals.segment(n, r.size()) = r, n += r.size();
   }
-  for (const Eigen::VectorXd& r : ef.r) out.final_chi2_frequency += o.objective == FitObjective::kSerep ? 0.0 : r[0] * r[0];
+  for (const Eigen::VectorXd& r : ef.r)
+    out.final_chi2_frequency += o.objective == FitObjective::kSerep ? 0.0 : r[0] * r[0];
   if (!out.converged)
     out.warnings.push_back("the fit stopped without converging (Ceres " + out.termination + " after " +
                            std::to_string(out.iterations) + " iterations, cost " + std::to_string(out.initial_cost) +
@@ -764,7 +765,8 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
                            "tie the parameters the data cannot determine");
   for (int k = 0; k < measured.num_modes(); ++k)
     if (ef.forced[k])
-      out.warnings.push_back("measured mode " + std::to_string(k + 1) + " (" + std::to_string(measured.frequencies_hz[k]) +
+      out.warnings.push_back("measured mode " + std::to_string(k + 1) + " (" +
+                             std::to_string(measured.frequencies_hz[k]) +
                              " Hz) pairs with no model mode at MAC >= " + std::to_string(o.min_mac) +
                              "; it was matched to the best remaining one (MAC " + std::to_string(ef.mac[k]) + ")");
 

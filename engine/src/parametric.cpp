@@ -140,13 +140,15 @@ void ParametricModel::build_element_terms(int e, const std::vector<int>& ps) con
     bool e, rho, a, i;  // which kinds act on it
   };
   const Eigen::MatrixXd Kbt = parts.K_bending + parts.K_torsion;
-  // Springs scale with a stiffness factor, point masses with a mass factor.
+  // Springs scale with a stiffness factor, point masses with a mass factor. (A table: one part a row.)
+  // clang-format off
   const PartDef defs[] = {{&parts.K_axial, false, true, false, true, false},
                           {&Kbt, false, true, false, false, true},
                           {&parts.K_discrete, false, true, false, false, false},
                           {&parts.M_translational, true, false, true, true, false},
                           {&parts.M_rotary, true, false, true, false, true},
                           {&parts.M_discrete, true, false, true, false, false}};
+  // clang-format on
   for (const PartDef& d : defs) {
     if (d.m->cwiseAbs().maxCoeff() == 0.0) continue;
     Term t;
@@ -170,7 +172,8 @@ void ParametricModel::build_element_terms(int e, const std::vector<int>& ps) con
           if (t.A(a, b) == 0.0 || dofs[a] < 0 || dofs[b] < 0) continue;
           const int q = position(dofs[a], dofs[b]);
           if (q < 0)
-            throw InternalError("ParametricModel: a nonzero entry of element " + std::to_string(e) + " outside the pattern");
+            throw InternalError("ParametricModel: a nonzero entry of element " + std::to_string(e) +
+                                " outside the pattern");
           t.ea.push_back(a);
           t.eb.push_back(b);
           t.ev.push_back(t.A(a, b));

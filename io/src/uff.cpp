@@ -108,8 +108,9 @@ std::vector<int> ids_and_types(const Ctx& c, const Block& b, std::size_t first, 
                                int* data_characteristic) {
   for (std::size_t k = 0; k < 5; ++k) (*id)[k] = std::string(rtrim(b.lines[first + k]));
   const std::size_t r = first + 5;
-  const auto v = int_record(c, b.lines[r], b.line_no[r], static_cast<int>(r) + 1, {10}, 6,
-                            "model type, analysis type, data characteristic, " + fourth + ", data type, values per node");
+  const auto v =
+      int_record(c, b.lines[r], b.line_no[r], static_cast<int>(r) + 1, {10}, 6,
+                 "model type, analysis type, data characteristic, " + fourth + ", data type, values per node");
   *model_type = v[0];
   *analysis_type = v[1];
   *data_characteristic = v[2];
@@ -423,7 +424,8 @@ Eigen::MatrixXcd node_values(const std::vector<double>& vals, Eigen::Index nn, i
 Uff55 read55(const Ctx& c, const Block& b) {
   require_header(c, b.lines.size(), 8, b.last_line);
   Uff55 d;
-  const auto r6 = ids_and_types(c, b, 0, "specific data type", &d.id, &d.model_type, &d.analysis_type, &d.data_characteristic);
+  const auto r6 =
+      ids_and_types(c, b, 0, "specific data type", &d.id, &d.model_type, &d.analysis_type, &d.data_characteristic);
   d.data_type_code = r6[3];
   if (r6[4] != 2 && r6[4] != 5)
     c.fail(record_name(6), b.line_no[5], "data type (field 5) must be 2 (real) or 5 (complex), found " + std::to_string(r6[4]));
