@@ -47,14 +47,13 @@ nlohmann::ordered_json identification_json(const IdentificationSummary& s) {
                         {"background_label", s.background_label}};
   nlohmann::ordered_json rejected = nlohmann::ordered_json::array();
   for (const RejectedCluster& r : s.rejected) {
-    nlohmann::ordered_json x;
-    x["frequency_hz"] = r.frequency_hz;
-    x["damping_ratio"] = r.damping_ratio;
-    x["poles"] = r.poles;
-    x["support"] = r.support;
-    x["reason"] = to_string(r.reason);
-    x["value"] = r.value;
-    x["limit"] = r.limit;
+    nlohmann::ordered_json x = {{"frequency_hz", r.frequency_hz},
+                                {"damping_ratio", r.damping_ratio},
+                                {"poles", r.poles},
+                                {"support", r.support},
+                                {"reason", to_string(r.reason)},
+                                {"value", r.value},
+                                {"limit", r.limit}};
     if (r.reason == Rejection::kSplit) x["merged_into"] = r.merged_into + 1;
     rejected.push_back(x);
   }
