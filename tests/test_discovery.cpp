@@ -68,6 +68,17 @@ ModalData exact_modes(const Model& truth, const Model& analysis, int count) {
   return sample_modes(truth, r, dofs, 0, count, "exact");
 }
 
+// The portal with node 2's base rotation free on a rotational spring of stiffness k (an explicit DOF and spring
+// element); bases 1 and 3 stay fixed.
+Model portal_on_base_spring(double k) {
+  Model m = test::UnsupportedCopy(make_frame2d(portal()));
+  m.add_element(test::GroundedSpring(9001, 2, Dof::RZ, k));
+  for (int id : {1, 3}) m.restrain(id, kAllDofs);
+  m.restrain(2, dof_bit(Dof::UX) | dof_bit(Dof::UY));
+  m.finalize();
+  return m;
+}
+
 // What a discovery concluded, for failure messages (the words are io's).
 std::string said(const DiscoverySummary& s) {
   std::string w = std::string(to_string(s.verdict)) + " (" + to_string(s.reason) + ")";
@@ -126,25 +137,8 @@ TEST(Discovery, ErrorLevelMaximizesTheLikelihoodWithTheFormErrorPrior) {
 
 TEST(Discovery, FlexibleBaseMatchesAnExplicitSpring) {
   const Model analysis = make_frame2d(portal());
-  Model truth = make_frame2d(portal());
-  // Rebuild the truth with node 2's rotation free and a spring on it.
-  Model t2;
-  for (const Node& n : truth.nodes()) t2.add_node(n.id, n.x);
-  for (const Material& m : truth.materials()) t2.add_material(m);
-  for (const Section& s : truth.sections()) t2.add_section(s);
-  for (const Element& e : truth.elements()) t2.add_element(e);
   const double k = 6.0e6;
-  Element sp;
-  sp.id = 9001;
-  sp.type = ElementType::Spring;
-  sp.num_nodes = 1;
-  sp.node_ids = {{2, 2}};
-  sp.spring_dofs = dof_bit(Dof::RZ);
-  sp.stiffness = k;
-  t2.add_element(sp);
-  for (int id : {1, 3}) t2.restrain(id, kAllDofs);
-  t2.restrain(2, dof_bit(Dof::UX) | dof_bit(Dof::UY));
-  t2.finalize();
+  const Model t2 = portal_on_base_spring(k);
   const ModalData meas = exact_modes(t2, analysis, 6);
   DiscoveryOptions o;
   const DiscoverySummary s = discover(analysis, meas, o);
@@ -166,25 +160,7 @@ TEST(Discovery, FlexibleBaseMatchesAnExplicitSpring) {
 // and select() must start from it and stop there.
 TEST(DiscoveryStages, FlexibleBaseThroughEachStage) {
   const Model analysis = make_frame2d(portal());
-  Model truth;
-  {
-    const Model base = make_frame2d(portal());
-    for (const Node& n : base.nodes()) truth.add_node(n.id, n.x);
-    for (const Material& m : base.materials()) truth.add_material(m);
-    for (const Section& s : base.sections()) truth.add_section(s);
-    for (const Element& e : base.elements()) truth.add_element(e);
-  }
-  Element sp;
-  sp.id = 9001;
-  sp.type = ElementType::Spring;
-  sp.num_nodes = 1;
-  sp.node_ids = {{2, 2}};
-  sp.spring_dofs = dof_bit(Dof::RZ);
-  sp.stiffness = 6.0e6;
-  truth.add_element(sp);
-  for (int id : {1, 3}) truth.restrain(id, kAllDofs);
-  truth.restrain(2, dof_bit(Dof::UX) | dof_bit(Dof::UY));
-  truth.finalize();
+  const Model truth = portal_on_base_spring(6.0e6);
   const ModalData meas = exact_modes(truth, analysis, 6);
 
   internal::Problem p;

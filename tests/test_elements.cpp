@@ -192,14 +192,7 @@ TEST(ElementRegistry, EveryTypeHasItsKind) {
 TEST(ElementRegistry, MemberOnlyQueriesRejectOtherKinds) {
   Model m;
   m.add_node(1, {0, 0, 0});
-  Element s;
-  s.id = 7;
-  s.type = ElementType::Spring;
-  s.num_nodes = 1;
-  s.node_ids = {{1, 0}};
-  s.spring_dofs = dof_bit(Dof::UX);
-  s.stiffness = 10;
-  m.add_element(s);
+  m.add_element(test::GroundedSpring(7, 1, Dof::UX, 10));
   m.finalize();
   EXPECT_THROW(m.unit_geometric_stiffness(0), InputError);
   EXPECT_THROW(m.member_point_interpolation(0, 0.5), InputError);
