@@ -162,5 +162,42 @@ TEST(Elements, PointMassAndSprings) {
   EXPECT_EQ(M(0, 0), 2.5);
 }
 
+// The element registry: every ElementType has its kind in its place, names parse back to their type, and the
+// kinds declare the nature the rest of dynid relies on (candidates, updating parameters, detection).
+TEST(ElementRegistry, EveryTypeHasItsKind) {
+  const std::vector<const ElementKind*>& kinds = element_kinds();
+  ASSERT_EQ(kinds.size(), 6u);
+  for (std::size_t i = 0; i < kinds.size(); ++i) {
+    const ElementType t = static_cast<ElementType>(i);
+    EXPECT_EQ(&element_kind(t), kinds[i]);
+    EXPECT_EQ(kinds[i]->type(), t);
+    ElementType back = ElementType::Matrix;
+    ASSERT_TRUE(parse_element_type(kinds[i]->name(), &back)) << kinds[i]->name();
+    EXPECT_EQ(back, t);
+    EXPECT_EQ(element_type_name(t), kinds[i]->name());
+  }
+  ElementType t;
+  EXPECT_FALSE(parse_element_type("truss", &t));
+  for (ElementType m : {ElementType::Beam2D, ElementType::Frame2D, ElementType::Frame3D}) {
+    EXPECT_TRUE(is_member(m));
+    EXPECT_TRUE(element_kind(m).has_stiffness() && element_kind(m).has_mass());
+    EXPECT_EQ(element_kind(m).spatial(), m == ElementType::Frame3D);
+  }
+  EXPECT_FALSE(is_member(ElementType::Matrix));
+  EXPECT_FALSE(element_kind(ElementType::PointMass).has_stiffness());
+  EXPECT_FALSE(element_kind(ElementType::Spring).has_mass());
+}
+
+// Non-members have no geometric stiffness or axis: a clear error naming the element, not a crash.
+TEST(ElementRegistry, MemberOnlyQueriesRejectOtherKinds) {
+  Model m;
+  m.add_node(1, {0, 0, 0});
+  m.add_element(test::GroundedSpring(7, 1, Dof::UX, 10));
+  m.finalize();
+  EXPECT_THROW(m.unit_geometric_stiffness(0), InputError);
+  EXPECT_THROW(m.member_point_interpolation(0, 0.5), InputError);
+  EXPECT_EQ(m.member_axial_force(0, Eigen::VectorXd::Ones(1)), 0.0);
+}
+
 }  // namespace
 }  // namespace dynid

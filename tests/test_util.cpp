@@ -24,15 +24,31 @@ Frame3DSpec SteelFrame3D(int bays_x, int bays_y, int stories) {
   return s;
 }
 
-Model WithoutSupports(const Model& base) {
+Model UnsupportedCopy(const Model& base) {
   Model m;
   for (const Material& x : base.materials()) m.add_material(x);
   for (const Section& x : base.sections()) m.add_section(x);
   for (const Node& n : base.nodes()) m.add_node(n.id, n.x);
   for (const Element& e : base.elements()) m.add_element(e);
+  return m;
+}
+
+Model WithoutSupports(const Model& base) {
+  Model m = UnsupportedCopy(base);
   m.set_free_free(true);
   m.finalize();
   return m;
+}
+
+Element GroundedSpring(int id, int node, Dof dof, double k) {
+  Element s;
+  s.id = id;
+  s.type = ElementType::Spring;
+  s.num_nodes = 1;
+  s.node_ids = {{node, 0}};
+  s.spring_dofs = dof_bit(dof);
+  s.stiffness = k;
+  return s;
 }
 
 double SubspaceGap(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {

@@ -100,7 +100,13 @@ inline Eigen::MatrixXd Dense(const SparseMatrix& A) { return Eigen::MatrixXd(A);
 /// eigenvalues.
 Frame3DSpec SteelFrame3D(int bays_x, int bays_y, int stories);
 
+/// The model's nodes, materials, sections and elements without its supports, not finalized (to add to).
+Model UnsupportedCopy(const Model& base);
+
 /// The model with its supports removed, declared free-free (finalized): 6 rigid-body modes.
 Model WithoutSupports(const Model& base);
+
+/// A one-node spring element to ground on DOF `dof` of node `node`, stiffness k.
+Element GroundedSpring(int id, int node, Dof dof, double k);
 
 }  // namespace dynid::test

@@ -103,12 +103,10 @@ std::vector<Cand> weighted_poles(const std::vector<std::vector<RawPole>>& orders
 }
 }  // namespace
 
-std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<RawPole>>& orders,
-                                               const std::vector<int>& order_of, double lo, double hi,
-                                               const IdentificationOptions& o, IdentificationSummary& s) {
-  const std::vector<Cand> cand = weighted_poles(orders, order_of, lo, hi, o, s);
-  if (cand.empty()) return {};
-  const double tol = o.cluster_tolerance;
+namespace {
+// Step 2: mean shift from every candidate to a maximum of the weighted density; converged points within a quarter
+// window of each other are one centre (their weighted mean). Sorted by frequency.
+std::vector<double> density_centres(const std::vector<Cand>& cand, double tol) {
   std::vector<double> fs(cand.size());
   for (std::size_t a = 0; a < cand.size(); ++a) fs[a] = cand[a].f;
   // Weighted mean of the candidates in the window around f.
@@ -124,7 +122,6 @@ std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<Raw
     *mass = sw;
     return sw > 0 ? swf / sw : f;
   };
-  // Step 2: mean shift from every candidate to a maximum of the weighted density.
   std::vector<std::pair<double, double>> tops;  // (converged frequency, weight of the start)
   for (const Cand& c : cand) {
     double f = c.f, mass = 0;
@@ -137,7 +134,6 @@ std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<Raw
     tops.emplace_back(f, c.w);
   }
   std::sort(tops.begin(), tops.end());
-  // Converged points within a quarter window of each other are one centre (their weighted mean).
   std::vector<double> centres;
   for (std::size_t a = 0; a < tops.size();) {
     std::size_t b = a + 1;
@@ -146,9 +142,15 @@ std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<Raw
     centres.push_back(sw > 0 ? swf / sw : tops[a].first);
     a = b;
   }
-  // Each candidate supports the centre it is nearest to (relative distance).
+  return centres;
+}
+
+using Members = std::vector<std::vector<std::pair<double, std::size_t>>>;  // centre -> (weight, candidate)
+
+// Each candidate supports the centre it is nearest to (relative distance).
+Members centre_members(const std::vector<Cand>& cand, const std::vector<double>& centres, double tol) {
   const std::size_t nc = centres.size();
-  std::vector<std::vector<std::pair<double, std::size_t>>> members(nc);  // centre -> (weight, cand)
+  Members members(nc);
   for (std::size_t a = 0; a < cand.size(); ++a) {
     const auto it = std::lower_bound(centres.begin(), centres.end(), cand[a].f);
     std::size_t c = static_cast<std::size_t>(it - centres.begin());
@@ -156,12 +158,20 @@ std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<Raw
     const double k = cand[a].w * window(std::abs(cand[a].f - centres[c]) / (tol * centres[c]));
     if (k > 0) members[c].emplace_back(k, a);
   }
-  // Shape families within a centre: the poles of the two modes of a closely spaced pair share one window, and
-  // their vectors tell them apart. Strongest first, each pole joins the family whose mean vector it is most like,
-  // fully from a MAC of cluster_mac, with a share falling to 0 at 2 cluster_mac - 1 (below the middle it starts
-  // a family of its own). Scalar vectors (LSCF with one input) make one family. Per family and order the best
-  // pole counts.
-  std::vector<std::map<int, std::pair<double, std::size_t>>> best;  // cluster -> order -> (weight, cand)
+  return members;
+}
+
+using OrderBest = std::map<int, std::pair<double, std::size_t>>;  // order -> (weight, candidate)
+
+// Shape families within a centre: the poles of the two modes of a closely spaced pair share one window, and
+// their vectors tell them apart. Strongest first, each pole joins the family whose mean vector it is most like,
+// fully from a MAC of cluster_mac, with a share falling to 0 at 2 cluster_mac - 1 (below the middle it starts
+// a family of its own). Scalar vectors (LSCF with one input) make one family. Per family and order the best
+// pole counts.
+std::vector<OrderBest> shape_families(Members members, const std::vector<Cand>& cand,
+                                      const std::vector<std::vector<RawPole>>& orders, const IdentificationOptions& o) {
+  const std::size_t nc = members.size();
+  std::vector<OrderBest> best;  // per family
   for (std::size_t c = 0; c < nc; ++c) {
     std::stable_sort(members[c].begin(), members[c].end(),
                      [](const auto& x, const auto& y) { return x.first > y.first; });
@@ -195,8 +205,14 @@ std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<Raw
       if (k * like > slot.first) slot = {k * like, a};
     }
   }
+  return best;
+}
+
+// A cluster of each family with poles at two orders or more: support, weighted frequency and damping and their
+// spreads. Sorted by frequency.
+std::vector<PoleCluster> clusters_of(const std::vector<OrderBest>& best, const std::vector<Cand>& cand, double n_orders,
+                                     const IdentificationSummary& s) {
   std::vector<PoleCluster> out;
-  const double n_orders = static_cast<double>(orders.size());
   for (std::size_t c = 0; c < best.size(); ++c) {
     if (best[c].size() < 2) continue;
     PoleCluster pc;
@@ -227,6 +243,18 @@ std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<Raw
   std::stable_sort(out.begin(), out.end(),
                    [](const PoleCluster& x, const PoleCluster& y) { return x.frequency_hz < y.frequency_hz; });
   return out;
+}
+
+}  // namespace
+
+std::vector<PoleCluster> stabilize_and_cluster(const std::vector<std::vector<RawPole>>& orders,
+                                               const std::vector<int>& order_of, double lo, double hi,
+                                               const IdentificationOptions& o, IdentificationSummary& s) {
+  const std::vector<Cand> cand = weighted_poles(orders, order_of, lo, hi, o, s);
+  if (cand.empty()) return {};
+  const std::vector<double> centres = density_centres(cand, o.cluster_tolerance);
+  const auto families = shape_families(centre_members(cand, centres, o.cluster_tolerance), cand, orders, o);
+  return clusters_of(families, cand, static_cast<double>(orders.size()), s);
 }
 
 namespace {

@@ -582,38 +582,31 @@ std::vector<int> free_parameters(const ParametricModel& pm, const std::vector<ch
 
 }  // namespace internal
 
-FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta0,
-                          const std::vector<char>& is_free, const FitOptions& o) {
+namespace {
+
+// The inputs' checks; the free parameters (not fixed by is_free, not tied).
+std::vector<int> check_fit_input(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta0,
+                                 const std::vector<char>& is_free, const FitOptions& o) {
   std::string why;
   if (!o.IsValid(&why)) throw InputError("fit options: " + why);
   measured.validate("measured modal data");
   if (theta0.size() != pm.num_parameters())
     throw InputError("fit: " + std::to_string(theta0.size()) + " start values for " + std::to_string(pm.num_parameters()) + " parameters");
-  const std::vector<int> free = internal::free_parameters(pm, is_free, o);
+  std::vector<int> free = internal::free_parameters(pm, is_free, o);
   if (free.empty()) throw InputError("fit: no free parameters");
   for (int p = 0; p < pm.num_parameters(); ++p) {
     const Parameter& q = pm.parameter(p);
     if (!(theta0[p] >= q.lower && theta0[p] <= q.upper))
       throw InputError("fit: start value of parameter '" + q.name + "' is outside its bounds");
   }
-  const auto t_start = std::chrono::steady_clock::now();
-  auto ev = std::make_shared<Evaluator>(pm, measured, theta0, free, o);
+  return free;
+}
+
+// The least-squares problem on x (the free parameters): one residual block per mode (two for the combined
+// objective: frequency and shape), each with the chosen loss, and the prior toward the nominal values.
+void add_cost(ceres::Problem* problem, const std::shared_ptr<Evaluator>& ev, const ParametricModel& pm,
+              const std::vector<int>& free, int modes, const FitOptions& o, double* x) {
   const int nf = static_cast<int>(free.size());
-  std::vector<double> x(free.size());
-  for (int k = 0; k < nf; ++k) x[k] = theta0[free[k]];
-
-  FitSummary out;
-  out.free_parameters = nf;
-  const Evaluation& e0 = ev->at(x.data(), false);
-  if (!e0.ok) throw NumericalError("fit: the model cannot be evaluated at the start values: " + e0.error);
-  out.measured_hz = measured.frequencies_hz;
-  out.initial_hz = paired_hz(e0);
-  out.initial_mac = e0.mac;
-
-  ceres::Problem::Options po;
-  po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
-  po.loss_function_ownership = ceres::TAKE_OWNERSHIP;
-  ceres::Problem problem(po);
   auto make_loss = [&]() -> ceres::LossFunction* {
     const double s2 = o.loss_scale * o.loss_scale;
     if (o.loss == FitOptions::Loss::kHuber) return new ceres::HuberLoss(s2);
@@ -621,12 +614,12 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
     return nullptr;
   };
   const int rows = ev->rows_per_mode();
-  for (int k = 0; k < measured.num_modes(); ++k) {
+  for (int k = 0; k < modes; ++k) {
     if (o.objective == FitObjective::kCombined) {  // frequency and shape as separate blocks
-      problem.AddResidualBlock(new ModeCost(ev, k, 0, 1, nf), make_loss(), x.data());
-      problem.AddResidualBlock(new ModeCost(ev, k, 1, rows - 1, nf), make_loss(), x.data());
+      problem->AddResidualBlock(new ModeCost(ev, k, 0, 1, nf), make_loss(), x);
+      problem->AddResidualBlock(new ModeCost(ev, k, 1, rows - 1, nf), make_loss(), x);
     } else {
-      problem.AddResidualBlock(new ModeCost(ev, k, 0, rows, nf), make_loss(), x.data());
+      problem->AddResidualBlock(new ModeCost(ev, k, 0, rows, nf), make_loss(), x);
     }
   }
   if (o.regularization > 0) {
@@ -638,8 +631,11 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
       lo[k] = q.lower;
       hi[k] = q.upper;
     }
-    problem.AddResidualBlock(new PriorCost(nom, w, lo, hi), nullptr, x.data());
+    problem->AddResidualBlock(new PriorCost(nom, w, lo, hi), nullptr, x);
   }
+}
+
+ceres::Solver::Options solver_options(const FitOptions& o) {
   ceres::Solver::Options so;
   so.trust_region_strategy_type = o.dogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
   so.linear_solver_type = ceres::DENSE_QR;
@@ -650,46 +646,15 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
   so.logging_type = ceres::SILENT;
   so.minimizer_progress_to_stdout = false;
   so.num_threads = 1;
-  CostRecorder rec(&out.cost_history);
-  so.callbacks.push_back(&rec);
-  so.update_state_every_iteration = false;
-  ceres::Solver::Summary sum;
-  ceres::Solve(so, &problem, &sum);
-  out.iterations = static_cast<int>(sum.iterations.size()) - 1;
-  out.termination = ceres::TerminationTypeToString(sum.termination_type);
-  out.converged = sum.termination_type == ceres::CONVERGENCE;
-  out.initial_cost = sum.initial_cost;
-  out.final_cost = sum.final_cost;
-  out.report = sum.FullReport();
-  out.theta = ev->theta_of(x.data());
-  for (int k = 0; k < nf; ++k) x[k] = out.theta[free[k]];  // the projected (evaluated) values
+  return so;
+}
 
-  const Evaluation& ef = ev->at(x.data(), true);
-  if (!ef.ok) throw NumericalError("fit: the model cannot be evaluated at the solution: " + ef.error);
-  out.final_hz = paired_hz(ef);
-  out.final_mac = ef.mac;
-  out.final_forced = ef.forced;
-  {
-    Eigen::Index n = 0;
-    for (const Eigen::VectorXd& r : ef.r) n += r.size();
-    out.final_residuals.resize(n);
-    n = 0;
-    for (const Eigen::VectorXd& r : ef.r) out.final_residuals.segment(n, r.size()) = r, n += r.size();
-  }
-  for (const Eigen::VectorXd& r : ef.r) out.final_chi2_frequency += o.objective == FitObjective::kSerep ? 0.0 : r[0] * r[0];
-  if (!out.converged)
-    out.warnings.push_back("the fit stopped without converging (Ceres " + out.termination + " after " +
-                           std::to_string(out.iterations) + " iterations, cost " + std::to_string(out.initial_cost) +
-                           " -> " + std::to_string(out.final_cost) +
-                           "): the parameters are the last iterate, not a minimum; raise max_iterations, or fix or "
-                           "tie the parameters the data cannot determine");
-  for (int k = 0; k < measured.num_modes(); ++k)
-    if (ef.forced[k])
-      out.warnings.push_back("measured mode " + std::to_string(k + 1) + " (" + std::to_string(measured.frequencies_hz[k]) +
-                             " Hz) pairs with no model mode at MAC >= " + std::to_string(o.min_mac) +
-                             "; it was matched to the best remaining one (MAC " + std::to_string(ef.mac[k]) + ")");
-
-  // Covariance from the final Jacobian (whitened residuals): (J^T J)^+ by SVD; rank reported.
+// Covariance from the final Jacobian (whitened residuals): (J^T J)^+ by SVD; rank, information matrices and the
+// standard deviations of the estimable parameters into `out`.
+void estimate_covariance(const Evaluation& ef, const ParametricModel& pm, const std::vector<int>& free,
+                         const FitOptions& o, FitSummary* out_ptr) {
+  FitSummary& out = *out_ptr;
+  const int nf = static_cast<int>(free.size());
   out.stddev = Eigen::VectorXd::Constant(pm.num_parameters(), std::numeric_limits<double>::quiet_NaN());
   {
     Eigen::Index rows = 0;
@@ -737,6 +702,75 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
                              std::to_string(nf) + " free parameters (J^T J is rank-deficient): the others trade off "
                              "against each other; fix or tie parameters, or add modes or DOFs");
   }
+}
+
+}  // namespace
+
+FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, const Eigen::VectorXd& theta0,
+                          const std::vector<char>& is_free, const FitOptions& o) {
+  const std::vector<int> free = check_fit_input(pm, measured, theta0, is_free, o);
+  const auto t_start = std::chrono::steady_clock::now();
+  auto ev = std::make_shared<Evaluator>(pm, measured, theta0, free, o);
+  const int nf = static_cast<int>(free.size());
+  std::vector<double> x(free.size());
+  for (int k = 0; k < nf; ++k) x[k] = theta0[free[k]];
+
+  FitSummary out;
+  out.free_parameters = nf;
+  const Evaluation& e0 = ev->at(x.data(), false);
+  if (!e0.ok) throw NumericalError("fit: the model cannot be evaluated at the start values: " + e0.error);
+  out.measured_hz = measured.frequencies_hz;
+  out.initial_hz = paired_hz(e0);
+  out.initial_mac = e0.mac;
+
+  ceres::Problem::Options po;
+  po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  po.loss_function_ownership = ceres::TAKE_OWNERSHIP;
+  ceres::Problem problem(po);
+  add_cost(&problem, ev, pm, free, measured.num_modes(), o, x.data());
+  ceres::Solver::Options so = solver_options(o);
+  CostRecorder rec(&out.cost_history);
+  so.callbacks.push_back(&rec);
+  so.update_state_every_iteration = false;
+  ceres::Solver::Summary sum;
+  ceres::Solve(so, &problem, &sum);
+  out.iterations = static_cast<int>(sum.iterations.size()) - 1;
+  out.termination = ceres::TerminationTypeToString(sum.termination_type);
+  out.converged = sum.termination_type == ceres::CONVERGENCE;
+  out.initial_cost = sum.initial_cost;
+  out.final_cost = sum.final_cost;
+  out.report = sum.FullReport();
+  out.theta = ev->theta_of(x.data());
+  for (int k = 0; k < nf; ++k) x[k] = out.theta[free[k]];  // the projected (evaluated) values
+
+  const Evaluation& ef = ev->at(x.data(), true);
+  if (!ef.ok) throw NumericalError("fit: the model cannot be evaluated at the solution: " + ef.error);
+  out.final_hz = paired_hz(ef);
+  out.final_mac = ef.mac;
+  out.final_forced = ef.forced;
+  {
+    Eigen::Index n = 0;
+    for (const Eigen::VectorXd& r : ef.r) n += r.size();
+    out.final_residuals.resize(n);
+    n = 0;
+    for (const Eigen::VectorXd& r : ef.r) out.final_residuals.segment(n, r.size()) = r, n += r.size();
+  }
+  for (const Eigen::VectorXd& r : ef.r)
+    out.final_chi2_frequency += o.objective == FitObjective::kSerep ? 0.0 : r[0] * r[0];
+  if (!out.converged)
+    out.warnings.push_back("the fit stopped without converging (Ceres " + out.termination + " after " +
+                           std::to_string(out.iterations) + " iterations, cost " + std::to_string(out.initial_cost) +
+                           " -> " + std::to_string(out.final_cost) +
+                           "): the parameters are the last iterate, not a minimum; raise max_iterations, or fix or "
+                           "tie the parameters the data cannot determine");
+  for (int k = 0; k < measured.num_modes(); ++k)
+    if (ef.forced[k])
+      out.warnings.push_back("measured mode " + std::to_string(k + 1) + " (" +
+                             std::to_string(measured.frequencies_hz[k]) +
+                             " Hz) pairs with no model mode at MAC >= " + std::to_string(o.min_mac) +
+                             "; it was matched to the best remaining one (MAC " + std::to_string(ef.mac[k]) + ")");
+
+  estimate_covariance(ef, pm, free, o, &out);
   const int ndata = ev->data_values();
   if (ndata > nf) out.residual_scale = std::sqrt(2.0 * out.final_cost / (ndata - nf));
   if (nf > ndata)

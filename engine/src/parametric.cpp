@@ -105,100 +105,96 @@ Eigen::VectorXd ParametricModel::nominal() const {
   return v;
 }
 
-void ParametricModel::build() const {
-  if (built_) return;
-  terms_.clear();
-  Kfixed_ = Eigen::Map<const Eigen::VectorXd>(K0_.valuePtr(), K0_.nonZeros());
-  Mfixed_ = Eigen::Map<const Eigen::VectorXd>(M0_.valuePtr(), M0_.nonZeros());
-  // The CSC position of entry (i, j), or -1 outside the pattern.
-  auto position = [&](int i, int j) {
-    const int* first = K0_.innerIndexPtr() + K0_.outerIndexPtr()[j];
-    const int* last = K0_.innerIndexPtr() + K0_.outerIndexPtr()[j + 1];
-    const int* it = std::lower_bound(first, last, i);
-    return it == last || *it != i ? -1 : static_cast<int>(it - K0_.innerIndexPtr());
-  };
-  auto positions = [&](const std::vector<int>& dofs) {
-    const int nd = static_cast<int>(dofs.size());
-    std::vector<int> pos(static_cast<std::size_t>(nd) * nd, -1);
-    for (int a = 0; a < nd; ++a)
-      for (int b = 0; b < nd; ++b) {
-        if (dofs[a] < 0 || dofs[b] < 0) continue;
-        const int q = position(dofs[a], dofs[b]);
-        if (q < 0) throw InternalError("ParametricModel: DOF pair outside the pattern");
-        pos[static_cast<std::size_t>(a) * nd + b] = q;
-      }
-    return pos;
-  };
-  // Factor parameters, grouped per element: each element part becomes one term with the parameters acting on it.
-  std::map<int, std::vector<int>> by_element;
-  for (int p = 0; p < num_parameters(); ++p)
-    for (int e : params_[p].elements) by_element[e].push_back(p);
-  std::vector<std::pair<int, int>> coupling;
-  for (const auto& [e, ps] : by_element) {
-    const ElementParts parts = model_.element_parts(e);
-    std::vector<int> dofs;
-    model_.element_dofs(e, &dofs);
-    // Elements assembled on their coupling (a group matrix of hundreds of DOFs, mostly zeros) keep their nonzero
-    // entries only: evaluations and sensitivities then cost their nonzeros, not the square of their DOFs.
-    const bool sparse = model_.element_coupling(e, &coupling);
-    const std::vector<int> pos = sparse ? std::vector<int>() : positions(dofs);
-    struct PartDef {
-      const Eigen::MatrixXd* m;
-      bool mass;
-      bool e, rho, a, i;  // which kinds act on it
-    };
-    const Eigen::MatrixXd Kbt = parts.K_bending + parts.K_torsion;
-    // Springs scale with a stiffness factor, point masses with a mass factor.
-    const PartDef defs[] = {{&parts.K_axial, false, true, false, true, false},
-                            {&Kbt, false, true, false, false, true},
-                            {&parts.K_discrete, false, true, false, false, false},
-                            {&parts.M_translational, true, false, true, true, false},
-                            {&parts.M_rotary, true, false, true, false, true},
-                            {&parts.M_discrete, true, false, true, false, false}};
-    for (const PartDef& d : defs) {
-      if (d.m->cwiseAbs().maxCoeff() == 0.0) continue;
-      Term t;
-      t.dofs = dofs;
-      t.A = *d.m;
-      t.pos = pos;
-      t.mass = d.mass;
-      for (int p : ps) {
-        const ParameterKind k = params_[p].kind;
-        const bool acts = (k == ParameterKind::kStiffness && d.e) || (k == ParameterKind::kMass && d.rho) ||
-                          (k == ParameterKind::kArea && d.a) || (k == ParameterKind::kInertia && d.i);
-        if (acts) t.params.push_back(p);
-      }
-      if (t.params.empty()) continue;  // this part is not parameterised: it stays in the fixed values
-      Eigen::VectorXd& fixed = t.mass ? Mfixed_ : Kfixed_;
-      const int nd = static_cast<int>(dofs.size());
-      if (sparse) {
-        t.sparse = true;
-        for (int b = 0; b < nd; ++b)
-          for (int a = 0; a < nd; ++a) {
-            if (t.A(a, b) == 0.0 || dofs[a] < 0 || dofs[b] < 0) continue;
-            const int q = position(dofs[a], dofs[b]);
-            if (q < 0)
-              throw InternalError("ParametricModel: a nonzero entry of element " + std::to_string(e) +
-                                  " outside the pattern");
-            t.ea.push_back(a);
-            t.eb.push_back(b);
-            t.ev.push_back(t.A(a, b));
-            t.epos.push_back(q);
-            fixed[q] -= t.A(a, b);
-          }
-        t.A.resize(0, 0);
-        t.pos.clear();
-      } else {
-        for (int a = 0; a < nd; ++a)
-          for (int b = 0; b < nd; ++b) {
-            const int q = pos[static_cast<std::size_t>(a) * nd + b];
-            if (q >= 0) fixed[q] -= t.A(a, b);
-          }
-      }
-      terms_.push_back(std::move(t));
+int ParametricModel::position(int i, int j) const {
+  const int* first = K0_.innerIndexPtr() + K0_.outerIndexPtr()[j];
+  const int* last = K0_.innerIndexPtr() + K0_.outerIndexPtr()[j + 1];
+  const int* it = std::lower_bound(first, last, i);
+  return it == last || *it != i ? -1 : static_cast<int>(it - K0_.innerIndexPtr());
+}
+
+std::vector<int> ParametricModel::positions(const std::vector<int>& dofs) const {
+  const int nd = static_cast<int>(dofs.size());
+  std::vector<int> pos(static_cast<std::size_t>(nd) * nd, -1);
+  for (int a = 0; a < nd; ++a)
+    for (int b = 0; b < nd; ++b) {
+      if (dofs[a] < 0 || dofs[b] < 0) continue;
+      const int q = position(dofs[a], dofs[b]);
+      if (q < 0) throw InternalError("ParametricModel: DOF pair outside the pattern");
+      pos[static_cast<std::size_t>(a) * nd + b] = q;
     }
+  return pos;
+}
+
+void ParametricModel::build_element_terms(int e, const std::vector<int>& ps) const {
+  const ElementParts parts = model_.element_parts(e);
+  std::vector<int> dofs;
+  model_.element_dofs(e, &dofs);
+  // Elements assembled on their coupling (a group matrix of hundreds of DOFs, mostly zeros) keep their nonzero
+  // entries only: evaluations and sensitivities then cost their nonzeros, not the square of their DOFs.
+  std::vector<std::pair<int, int>> coupling;
+  const bool sparse = model_.element_coupling(e, &coupling);
+  const std::vector<int> pos = sparse ? std::vector<int>() : positions(dofs);
+  struct PartDef {
+    const Eigen::MatrixXd* m;
+    bool mass;
+    bool e, rho, a, i;  // which kinds act on it
+  };
+  const Eigen::MatrixXd Kbt = parts.K_bending + parts.K_torsion;
+  // Springs scale with a stiffness factor, point masses with a mass factor. (A table: one part a row.)
+  // clang-format off
+  const PartDef defs[] = {{&parts.K_axial, false, true, false, true, false},
+                          {&Kbt, false, true, false, false, true},
+                          {&parts.K_discrete, false, true, false, false, false},
+                          {&parts.M_translational, true, false, true, true, false},
+                          {&parts.M_rotary, true, false, true, false, true},
+                          {&parts.M_discrete, true, false, true, false, false}};
+  // clang-format on
+  for (const PartDef& d : defs) {
+    if (d.m->cwiseAbs().maxCoeff() == 0.0) continue;
+    Term t;
+    t.dofs = dofs;
+    t.A = *d.m;
+    t.pos = pos;
+    t.mass = d.mass;
+    for (int p : ps) {
+      const ParameterKind k = params_[p].kind;
+      const bool acts = (k == ParameterKind::kStiffness && d.e) || (k == ParameterKind::kMass && d.rho) ||
+                        (k == ParameterKind::kArea && d.a) || (k == ParameterKind::kInertia && d.i);
+      if (acts) t.params.push_back(p);
+    }
+    if (t.params.empty()) continue;  // this part is not parameterised: it stays in the fixed values
+    Eigen::VectorXd& fixed = t.mass ? Mfixed_ : Kfixed_;
+    const int nd = static_cast<int>(dofs.size());
+    if (sparse) {
+      t.sparse = true;
+      for (int b = 0; b < nd; ++b)
+        for (int a = 0; a < nd; ++a) {
+          if (t.A(a, b) == 0.0 || dofs[a] < 0 || dofs[b] < 0) continue;
+          const int q = position(dofs[a], dofs[b]);
+          if (q < 0)
+            throw InternalError("ParametricModel: a nonzero entry of element " + std::to_string(e) +
+                                " outside the pattern");
+          t.ea.push_back(a);
+          t.eb.push_back(b);
+          t.ev.push_back(t.A(a, b));
+          t.epos.push_back(q);
+          fixed[q] -= t.A(a, b);
+        }
+      t.A.resize(0, 0);
+      t.pos.clear();
+    } else {
+      for (int a = 0; a < nd; ++a)
+        for (int b = 0; b < nd; ++b) {
+          const int q = pos[static_cast<std::size_t>(a) * nd + b];
+          if (q >= 0) fixed[q] -= t.A(a, b);
+        }
+    }
+    terms_.push_back(std::move(t));
   }
-  // Additive parameters: unit matrices on the node's DOFs, scaled by theta.
+}
+
+// Additive parameters: unit matrices on the node's DOFs, scaled by theta.
+void ParametricModel::build_additive_terms() const {
   for (int p = 0; p < num_parameters(); ++p) {
     const Parameter& q = params_[p];
     if (q.kind != ParameterKind::kPointMass && q.kind != ParameterKind::kSpring) continue;
@@ -212,6 +208,19 @@ void ParametricModel::build() const {
     t.additive = true;
     terms_.push_back(std::move(t));
   }
+}
+
+void ParametricModel::build() const {
+  if (built_) return;
+  terms_.clear();
+  Kfixed_ = Eigen::Map<const Eigen::VectorXd>(K0_.valuePtr(), K0_.nonZeros());
+  Mfixed_ = Eigen::Map<const Eigen::VectorXd>(M0_.valuePtr(), M0_.nonZeros());
+  // Factor parameters, grouped per element: each element part becomes one term with the parameters acting on it.
+  std::map<int, std::vector<int>> by_element;
+  for (int p = 0; p < num_parameters(); ++p)
+    for (int e : params_[p].elements) by_element[e].push_back(p);
+  for (const auto& [e, ps] : by_element) build_element_terms(e, ps);
+  build_additive_terms();
   custom_of_param_.assign(params_.size(), {});
   for (std::size_t k = 0; k < custom_.size(); ++k) {
     try {

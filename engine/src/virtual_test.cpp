@@ -95,50 +95,24 @@ bool VirtualTestOptions::IsValid(std::string* why) const {
   return true;
 }
 
-VirtualTest simulate_test(const Model& model, const ModalResult& modal, const VirtualTestOptions& o) {
-  std::string why;
-  if (!o.IsValid(&why)) throw InputError("virtual test: " + why);
-  const double fs = o.sample_rate_hz, h = 1.0 / fs, nyquist = fs / 2;
-  const int n = static_cast<int>(std::llround(o.duration_s * fs));
-  const double band_lo = o.band_hz_lo, band_hi = o.band_hz_hi > 0 ? o.band_hz_hi : 0.4 * fs;
+namespace {
 
-  // Modes kept: below Nyquist (an ideal anti-alias filter). The caller must have computed past it.
-  std::vector<int> kept;
-  for (int j = 0; j < modal.modes.cols(); ++j)
-    if (modal.frequencies_hz[j] < nyquist) kept.push_back(j);
-  if (kept.empty()) throw InputError("virtual test: no mode below the Nyquist frequency " + std::to_string(nyquist) + " Hz");
-  if (static_cast<int>(kept.size()) == modal.modes.cols() && modal.frequencies_hz[modal.modes.cols() - 1] < 0.8 * nyquist)
-    throw InputError("virtual test: the modal basis stops at " + std::to_string(modal.frequencies_hz[modal.modes.cols() - 1]) +
-                     " Hz, below the Nyquist frequency " + std::to_string(nyquist) + " Hz; compute more modes");
-  const int m = static_cast<int>(kept.size());
-  std::vector<ModeMap> maps(static_cast<std::size_t>(m));
-  Eigen::VectorXd zeta(m);
-  for (int a = 0; a < m; ++a) {
-    const double lam = modal.rigid_body[kept[a]] ? 0.0 : std::max(0.0, modal.eigenvalues[kept[a]]);
-    const double w = std::sqrt(lam);
-    const double c = o.damping == VirtualTestOptions::Damping::kModal ? 2 * o.damping_ratio * w : o.rayleigh_alpha + o.rayleigh_beta * lam;
-    zeta[a] = w > 0 ? c / (2 * w) : 0;
-    maps[a] = mode_map(lam, c, h);
-  }
-
-  auto rows_of = [&](const std::vector<MeasuredDof>& dofs) {
-    const std::vector<int> eq = measured_equations(model, dofs);
-    Eigen::MatrixXd P(static_cast<Eigen::Index>(dofs.size()), m);
-    for (std::size_t r = 0; r < dofs.size(); ++r)
-      for (int a = 0; a < m; ++a) P(static_cast<Eigen::Index>(r), a) = modal.modes(eq[r], kept[a]);
-    return P;
-  };
-  const Eigen::MatrixXd Ps = rows_of(o.sensors);  // sensors x modes
-  std::vector<MeasuredDof> force_dofs = o.inputs;
-  if (o.excitation == Excitation::kAmbient) {
-    force_dofs.clear();
-    for (const MeasuredDof& d : all_dofs(model))
-      if (d.dof == Dof::UX || d.dof == Dof::UY || d.dof == Dof::UZ) force_dofs.push_back(d);
-  }
-  const Eigen::MatrixXd Pf = rows_of(force_dofs);  // force DOFs x modes
+// The modal model of a virtual test: the modes kept, their exact step maps, and the sensor and force rows.
+struct ModalSimulator {
+  explicit ModalSimulator(const VirtualTestOptions& options) : o(options) {}
+  const VirtualTestOptions& o;
+  double fs = 0, h = 0;
+  int n = 0;                  // samples per record
+  std::vector<int> kept;      // modes simulated (indices into the modal result)
+  std::vector<ModeMap> maps;  // their step maps
+  Eigen::VectorXd zeta;       // their damping ratios
+  Eigen::MatrixXd Ps, Pf;     // sensors x modes, force DOFs x modes
+  std::vector<MeasuredDof> force_dofs;
+  Eigen::Index ns = 0;  // sensors
 
   // Response of every sensor to forces F (samples x force DOFs).
-  auto respond = [&](const Eigen::MatrixXd& F) {
+  Eigen::MatrixXd respond(const Eigen::MatrixXd& F) const {
+    const int m = static_cast<int>(kept.size());
     const Eigen::MatrixXd p = F * Pf;  // modal forces, samples x modes
     Eigen::MatrixXd q(n, m);
 #pragma omp parallel for schedule(static)
@@ -154,86 +128,166 @@ VirtualTest simulate_test(const Model& model, const ModalResult& modal, const Vi
       }
     }
     return Eigen::MatrixXd(q * Ps.transpose());
-  };
+  }
 
-  VirtualTest out;
-  const std::string src = "virtual test";
-  auto make_channels = [&](const std::vector<MeasuredDof>& forces) {
+  // The sensors' channels, then one force channel per DOF of `forces`.
+  std::vector<Channel> channels(const std::vector<MeasuredDof>& forces) const {
     std::vector<Channel> ch;
     const char* unit = o.response == Quantity::kAcceleration ? "m/s^2" : o.response == Quantity::kVelocity ? "m/s" : "m";
     for (const MeasuredDof& d : o.sensors) ch.push_back({to_string(d), d, o.response, unit, false});
     for (const MeasuredDof& d : forces) ch.push_back({to_string(d) + " force", d, Quantity::kForce, "N", true});
     return ch;
-  };
-  const Eigen::Index ns = static_cast<Eigen::Index>(o.sensors.size());
-  auto finish_record = [&](Eigen::MatrixXd& Y, std::uint64_t record) {
+  }
+
+  // Measurement noise on every channel of a record (sensors: o.noise, forces: o.force_noise).
+  void finish_record(Eigen::MatrixXd& Y, std::uint64_t record) const {
     for (Eigen::Index c = 0; c < Y.cols(); ++c) {
       std::mt19937_64 rng = stream_rng(o.seed, record, 1000000 + static_cast<std::uint64_t>(c));
       add_noise(Y.col(c), c < ns ? o.noise : o.force_noise, rng);
     }
-  };
+  }
+};
 
-  if (o.excitation == Excitation::kImpact) {
-    const double tp = o.pulse_s > 0 ? o.pulse_s : std::max(0.75 / band_hi, 4.0 / fs);
-    if (tp * fs < 3) throw InputError("virtual test: the impact pulse (" + std::to_string(tp) + " s) spans fewer than 3 samples; raise the sampling rate");
-    const double t0 = o.pretrigger * o.duration_s;
-    std::uint64_t record = 0;
-    for (std::size_t i = 0; i < o.inputs.size(); ++i) {
-      Recording r;
-      r.sample_rate_hz = fs;
-      r.channels = make_channels({o.inputs[i]});
-      r.source = src + " (impact at " + to_string(o.inputs[i]) + ")";
-      for (int hit = 0; hit < o.impacts; ++hit, ++record) {
-        std::mt19937_64 rng = stream_rng(o.seed, record, 0);
-        const double amp = o.force_rms * std::uniform_real_distribution<double>(0.8, 1.2)(rng);
-        Eigen::MatrixXd F = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(o.inputs.size()));
-        for (int k = 0; k < n; ++k) {
-          const double t = k * h - t0;
-          if (t > 0 && t < tp) F(k, static_cast<Eigen::Index>(i)) = amp * std::sin(kPi * t / tp);
-        }
-        Eigen::MatrixXd Y(n, ns + 1);
-        Y.leftCols(ns) = respond(F);
-        Y.col(ns) = F.col(static_cast<Eigen::Index>(i));
-        finish_record(Y, record);
-        r.records.push_back(std::move(Y));
-      }
-      out.recordings.push_back(std::move(r));
-    }
-  } else {
-    const Eigen::Index nf = static_cast<Eigen::Index>(force_dofs.size());
-    Eigen::MatrixXd F(n, nf);
-    for (Eigen::Index c = 0; c < nf; ++c) {
-      std::mt19937_64 rng = stream_rng(o.seed, 0, static_cast<std::uint64_t>(c));
-      F.col(c) = band_noise(n, fs, band_lo, band_hi, o.force_rms, rng);
-    }
+// Modes kept: below Nyquist (an ideal anti-alias filter), with their step maps and the rows of the sensors and forces.
+ModalSimulator modal_simulator(const Model& model, const ModalResult& modal, const VirtualTestOptions& o) {
+  ModalSimulator sim(o);
+  sim.fs = o.sample_rate_hz;
+  sim.h = 1.0 / sim.fs;
+  sim.n = static_cast<int>(std::llround(o.duration_s * sim.fs));
+  const double nyquist = sim.fs / 2;
+  // The caller must have computed past the Nyquist frequency.
+  std::vector<int>& kept = sim.kept;
+  for (int j = 0; j < modal.modes.cols(); ++j)
+    if (modal.frequencies_hz[j] < nyquist) kept.push_back(j);
+  if (kept.empty())
+    throw InputError("virtual test: no mode below the Nyquist frequency " + std::to_string(nyquist) + " Hz");
+  if (static_cast<int>(kept.size()) == modal.modes.cols() &&
+      modal.frequencies_hz[modal.modes.cols() - 1] < 0.8 * nyquist)
+    throw InputError("virtual test: the modal basis stops at " +
+                     std::to_string(modal.frequencies_hz[modal.modes.cols() - 1]) +
+                     " Hz, below the Nyquist frequency " + std::to_string(nyquist) + " Hz; compute more modes");
+  const int m = static_cast<int>(kept.size());
+  sim.maps.resize(static_cast<std::size_t>(m));
+  sim.zeta.resize(m);
+  for (int a = 0; a < m; ++a) {
+    const double lam = modal.rigid_body[kept[a]] ? 0.0 : std::max(0.0, modal.eigenvalues[kept[a]]);
+    const double w = std::sqrt(lam);
+    const double c = o.damping == VirtualTestOptions::Damping::kModal ? 2 * o.damping_ratio * w
+                                                                      : o.rayleigh_alpha + o.rayleigh_beta * lam;
+    sim.zeta[a] = w > 0 ? c / (2 * w) : 0;
+    sim.maps[a] = mode_map(lam, c, sim.h);
+  }
+  auto rows_of = [&](const std::vector<MeasuredDof>& dofs) {
+    const std::vector<int> eq = measured_equations(model, dofs);
+    Eigen::MatrixXd P(static_cast<Eigen::Index>(dofs.size()), m);
+    for (std::size_t r = 0; r < dofs.size(); ++r)
+      for (int a = 0; a < m; ++a) P(static_cast<Eigen::Index>(r), a) = modal.modes(eq[r], kept[a]);
+    return P;
+  };
+  sim.Ps = rows_of(o.sensors);
+  sim.force_dofs = o.inputs;
+  if (o.excitation == Excitation::kAmbient) {
+    sim.force_dofs.clear();
+    for (const MeasuredDof& d : all_dofs(model))
+      if (d.dof == Dof::UX || d.dof == Dof::UY || d.dof == Dof::UZ) sim.force_dofs.push_back(d);
+  }
+  sim.Pf = rows_of(sim.force_dofs);
+  sim.ns = static_cast<Eigen::Index>(o.sensors.size());
+  return sim;
+}
+
+// Impact test: one recording per input DOF, o.impacts records each (a half-sine pulse of random amplitude).
+void impact_recordings(const ModalSimulator& sim, double band_hi, const std::string& src, VirtualTest* out) {
+  const VirtualTestOptions& o = sim.o;
+  const int n = sim.n;
+  const double fs = sim.fs;
+  const double tp = o.pulse_s > 0 ? o.pulse_s : std::max(0.75 / band_hi, 4.0 / fs);
+  if (tp * fs < 3)
+    throw InputError("virtual test: the impact pulse (" + std::to_string(tp) +
+                     " s) spans fewer than 3 samples; raise the sampling rate");
+  const double t0 = o.pretrigger * o.duration_s;
+  std::uint64_t record = 0;
+  for (std::size_t i = 0; i < o.inputs.size(); ++i) {
     Recording r;
     r.sample_rate_hz = fs;
-    const bool ambient = o.excitation == Excitation::kAmbient;
-    r.channels = make_channels(ambient ? std::vector<MeasuredDof>{} : force_dofs);
-    r.source = src + (ambient ? " (ambient)" : " (random force)");
-    Eigen::MatrixXd Y(n, ns + (ambient ? 0 : nf));
-    Y.leftCols(ns) = respond(F);
-    if (!ambient) Y.rightCols(nf) = F;
-    finish_record(Y, 0);
-    r.records.push_back(std::move(Y));
-    out.recordings.push_back(std::move(r));
+    r.channels = sim.channels({o.inputs[i]});
+    r.source = src + " (impact at " + to_string(o.inputs[i]) + ")";
+    for (int hit = 0; hit < o.impacts; ++hit, ++record) {
+      std::mt19937_64 rng = stream_rng(o.seed, record, 0);
+      const double amp = o.force_rms * std::uniform_real_distribution<double>(0.8, 1.2)(rng);
+      Eigen::MatrixXd F = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(o.inputs.size()));
+      for (int k = 0; k < n; ++k) {
+        const double t = k * sim.h - t0;
+        if (t > 0 && t < tp) F(k, static_cast<Eigen::Index>(i)) = amp * std::sin(kPi * t / tp);
+      }
+      Eigen::MatrixXd Y(n, sim.ns + 1);
+      Y.leftCols(sim.ns) = sim.respond(F);
+      Y.col(sim.ns) = F.col(static_cast<Eigen::Index>(i));
+      sim.finish_record(Y, record);
+      r.records.push_back(std::move(Y));
+    }
+    out->recordings.push_back(std::move(r));
   }
+}
 
-  // The truth.
-  ModalData& t = out.modes;
-  t.dofs = o.sensors;
+// Random-force or ambient test: one record, band-limited noise at every force DOF.
+void random_recording(const ModalSimulator& sim, double band_lo, double band_hi, const std::string& src,
+                      VirtualTest* out) {
+  const VirtualTestOptions& o = sim.o;
+  const int n = sim.n;
+  const Eigen::Index nf = static_cast<Eigen::Index>(sim.force_dofs.size());
+  Eigen::MatrixXd F(n, nf);
+  for (Eigen::Index c = 0; c < nf; ++c) {
+    std::mt19937_64 rng = stream_rng(o.seed, 0, static_cast<std::uint64_t>(c));
+    F.col(c) = band_noise(n, sim.fs, band_lo, band_hi, o.force_rms, rng);
+  }
+  Recording r;
+  r.sample_rate_hz = sim.fs;
+  const bool ambient = o.excitation == Excitation::kAmbient;
+  r.channels = sim.channels(ambient ? std::vector<MeasuredDof>{} : sim.force_dofs);
+  r.source = src + (ambient ? " (ambient)" : " (random force)");
+  Eigen::MatrixXd Y(n, sim.ns + (ambient ? 0 : nf));
+  Y.leftCols(sim.ns) = sim.respond(F);
+  if (!ambient) Y.rightCols(nf) = F;
+  sim.finish_record(Y, 0);
+  r.records.push_back(std::move(Y));
+  out->recordings.push_back(std::move(r));
+}
+
+// The truth: the simulated elastic modes at the sensors.
+ModalData simulated_modes(const ModalSimulator& sim, const ModalResult& modal) {
+  ModalData t;
+  t.dofs = sim.o.sensors;
   t.source = "simulated modes";
+  const std::vector<int>& kept = sim.kept;
   std::vector<int> el;
-  for (int a = 0; a < m; ++a)
+  for (int a = 0; a < static_cast<int>(kept.size()); ++a)
     if (!modal.rigid_body[kept[a]] && modal.frequencies_hz[kept[a]] > 0) el.push_back(a);
   t.frequencies_hz.resize(static_cast<Eigen::Index>(el.size()));
   t.damping_ratios.resize(static_cast<Eigen::Index>(el.size()));
-  t.shapes.resize(ns, static_cast<Eigen::Index>(el.size()));
+  t.shapes.resize(sim.ns, static_cast<Eigen::Index>(el.size()));
   for (std::size_t b = 0; b < el.size(); ++b) {
     t.frequencies_hz[static_cast<Eigen::Index>(b)] = modal.frequencies_hz[kept[el[b]]];
-    t.damping_ratios[static_cast<Eigen::Index>(b)] = zeta[el[b]];
-    t.shapes.col(static_cast<Eigen::Index>(b)) = Ps.col(el[b]);
+    t.damping_ratios[static_cast<Eigen::Index>(b)] = sim.zeta[el[b]];
+    t.shapes.col(static_cast<Eigen::Index>(b)) = sim.Ps.col(el[b]);
   }
+  return t;
+}
+
+}  // namespace
+
+VirtualTest simulate_test(const Model& model, const ModalResult& modal, const VirtualTestOptions& o) {
+  std::string why;
+  if (!o.IsValid(&why)) throw InputError("virtual test: " + why);
+  const double band_lo = o.band_hz_lo, band_hi = o.band_hz_hi > 0 ? o.band_hz_hi : 0.4 * o.sample_rate_hz;
+  const ModalSimulator sim = modal_simulator(model, modal, o);
+  VirtualTest out;
+  const std::string src = "virtual test";
+  if (o.excitation == Excitation::kImpact)
+    impact_recordings(sim, band_hi, src, &out);
+  else
+    random_recording(sim, band_lo, band_hi, src, &out);
+  out.modes = simulated_modes(sim, modal);
   return out;
 }
 

@@ -24,8 +24,8 @@ std::vector<int> element_list(const YAML::Node& n, const YamlCtx& ctx, const Mod
   std::vector<int> out;
   if (n.IsScalar() && n.Scalar() == "all") {
     for (int e = 0; e < model.num_elements(); ++e) {
-      const ElementType t = model.elements()[e].type;
-      if (t != ElementType::PointMass && t != ElementType::Spring) out.push_back(e);
+      const ElementKind& k = element_kind(model.elements()[e].type);  // members and matrix elements
+      if (k.has_stiffness() && k.has_mass()) out.push_back(e);
     }
     return out;
   }
@@ -214,11 +214,10 @@ UpdateSpec parse_update(const YAML::Node& n, const YamlCtx& ctx, const Model& mo
             for (int k = 0; k < nn; ++k) c += model.nodes()[en[k]].x / nn;
             bool in = true;
             for (int k = 0; k < 3; ++k) in = in && c[k] >= lo[k] && c[k] <= hi[k];
-            const ElementType t = model.elements()[e].type;
-            const bool fits = base.kind == ParameterKind::kStiffness ? t != ElementType::PointMass
-                              : base.kind == ParameterKind::kMass    ? t != ElementType::Spring
-                                                                     : t != ElementType::PointMass && t != ElementType::Spring &&
-                                                                           t != ElementType::Matrix;
+            const ElementKind& k = element_kind(model.elements()[e].type);
+            const bool fits = base.kind == ParameterKind::kStiffness ? k.has_stiffness()
+                              : base.kind == ParameterKind::kMass    ? k.has_mass()
+                                                                     : k.is_member();  // A, I: sections only
             if (in && fits) p.elements.push_back(e);
           }
           if (p.elements.empty()) ctx.fail(r, "parameter " + name + ": the region holds no element");

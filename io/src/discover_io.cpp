@@ -7,13 +7,14 @@
 
 #include "dynid/io/figures.hpp"
 #include "dynid/io/modal_data_io.hpp"
+#include "internal/json_util.hpp"
 #include "internal/text_util.hpp"
 
 namespace dynid {
 
-namespace {
+using internal::vec;
 
-std::vector<double> vec(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+namespace {
 
 bool shares(const std::vector<int>& have, const std::vector<int>& want) {
   for (int w : want)

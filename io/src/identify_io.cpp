@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include "dynid/io/modal_data_io.hpp"
+#include "internal/json_util.hpp"
 
 namespace dynid {
 
@@ -41,19 +42,18 @@ nlohmann::ordered_json identification_json(const IdentificationSummary& s) {
     poles.push_back({p.order, p.frequency_hz, p.damping_ratio, cls, p.cluster + 1});
   }
   j["stabilization"] = {{"poles", poles},
-                        {"frequency_hz", std::vector<double>(s.frequency_hz.data(), s.frequency_hz.data() + s.frequency_hz.size())},
-                        {"background", std::vector<double>(s.background.data(), s.background.data() + s.background.size())},
+                        {"frequency_hz", internal::vec(s.frequency_hz)},
+                        {"background", internal::vec(s.background)},
                         {"background_label", s.background_label}};
   nlohmann::ordered_json rejected = nlohmann::ordered_json::array();
   for (const RejectedCluster& r : s.rejected) {
-    nlohmann::ordered_json x;
-    x["frequency_hz"] = r.frequency_hz;
-    x["damping_ratio"] = r.damping_ratio;
-    x["poles"] = r.poles;
-    x["support"] = r.support;
-    x["reason"] = to_string(r.reason);
-    x["value"] = r.value;
-    x["limit"] = r.limit;
+    nlohmann::ordered_json x = {{"frequency_hz", r.frequency_hz},
+                                {"damping_ratio", r.damping_ratio},
+                                {"poles", r.poles},
+                                {"support", r.support},
+                                {"reason", to_string(r.reason)},
+                                {"value", r.value},
+                                {"limit", r.limit}};
     if (r.reason == Rejection::kSplit) x["merged_into"] = r.merged_into + 1;
     rejected.push_back(x);
   }

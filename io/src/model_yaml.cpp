@@ -101,8 +101,7 @@ struct Parser {
   ElementType member_type(const YAML::Node& n, const std::string& w, const std::string& hint = "") const {
     const std::string t = ctx.string(n, w + " type");
     ElementType type;
-    if (!parse_element_type(t, &type) || type == ElementType::PointMass || type == ElementType::Spring ||
-        type == ElementType::Matrix)
+    if (!parse_element_type(t, &type) || !is_member(type))
       fail(n, w + ": unknown element type '" + t + "' (known: beam2d, frame2d, frame3d" + hint + ")");
     return type;
   }

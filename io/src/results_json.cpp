@@ -6,14 +6,15 @@
 
 #include "dynid/io/point_map.hpp"
 #include "dynid/mesh/error.hpp"
+#include "internal/json_util.hpp"
 #include "internal/text_util.hpp"
 
 namespace dynid {
 
 using internal::format_number;
+using internal::vec;
 
 namespace {
-std::vector<double> vec(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
 nlohmann::json num(double v) { return std::isnan(v) ? nlohmann::json() : nlohmann::json(v); }
 }  // namespace
 

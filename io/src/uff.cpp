@@ -74,6 +74,13 @@ Block read_block(internal::LineReader& in) {
 
 std::string record_name(int r) { return "record " + std::to_string(r); }
 
+/// A dataset's header must have its n records; `line` is where the file or block ended.
+void require_header(const Ctx& c, std::size_t have, std::size_t n, int line) {
+  if (have < n)
+    c.fail(record_name(static_cast<int>(have) + 1), line,
+           "the header has " + std::to_string(have) + " of its " + std::to_string(n) + " records (file truncated?)");
+}
+
 /// Integer fields of a record: by blanks, else by fixed widths. At least `min_fields` are required; missing
 /// optional ones are 0.
 std::vector<int> int_record(const Ctx& c, std::string_view line, int line_no, int record,
@@ -91,6 +98,23 @@ std::vector<int> int_record(const Ctx& c, std::string_view line, int line_no, in
     out.push_back(static_cast<int>(v[k]));
   }
   return out;
+}
+
+/// The five ID lines of a dataset of nodal values (55, 2414) from line `first`, then the record of six integers
+/// after them: model type, analysis type, data characteristic (stored), the dataset's own type (`fourth`), data
+/// type and values per node (returned with the others, for the caller to check).
+std::vector<int> ids_and_types(const Ctx& c, const Block& b, std::size_t first, const std::string& fourth,
+                               std::array<std::string, 5>* id, int* model_type, int* analysis_type,
+                               int* data_characteristic) {
+  for (std::size_t k = 0; k < 5; ++k) (*id)[k] = std::string(rtrim(b.lines[first + k]));
+  const std::size_t r = first + 5;
+  const auto v =
+      int_record(c, b.lines[r], b.line_no[r], static_cast<int>(r) + 1, {10}, 6,
+                 "model type, analysis type, data characteristic, " + fourth + ", data type, values per node");
+  *model_type = v[0];
+  *analysis_type = v[1];
+  *data_characteristic = v[2];
+  return v;
 }
 
 std::string field_text(std::string_view line, std::size_t begin, std::size_t width) {
@@ -234,9 +258,7 @@ void parse58_header(const Ctx& c, const std::vector<std::string_view>& lines, co
 }
 
 Uff58 read58_ascii(const Ctx& c, const Block& b) {
-  if (b.lines.size() < 11)
-    c.fail(record_name(static_cast<int>(b.lines.size()) + 1), b.last_line,
-           "the header has " + std::to_string(b.lines.size()) + " of its 11 records (file truncated?)");
+  require_header(c, b.lines.size(), 11, b.last_line);
   Uff58 d;
   long long n = 0;
   parse58_header(c, b.lines, b.line_no, &d, &n);
@@ -308,9 +330,7 @@ Uff58 read58_binary(const Ctx& c, internal::LineReader& in, std::string_view typ
     head.lines.push_back(l);
     head.line_no.push_back(in.line());
   }
-  if (head.lines.size() < 11)
-    c.fail(record_name(static_cast<int>(head.lines.size()) + 1), in.line(),
-           "the header has " + std::to_string(head.lines.size()) + " of its 11 records (file truncated?)");
+  require_header(c, head.lines.size(), 11, in.line());
   Uff58 d;
   d.binary = true;
   d.big_endian = h[0] == 2;
@@ -368,17 +388,44 @@ std::size_t read_values(const Ctx& c, const Block& b, std::size_t k, std::size_t
   return k;
 }
 
+/// The node records of a 55 or 2414 data set from line k to the block's end: a node number (record
+/// `node_record`, I10) followed by `per_node` values (record node_record + 1; a short count is reported at the node
+/// line when `count_at_node`). Fills the node numbers and the values in file order.
+void read_node_values(const Ctx& c, const Block& b, std::size_t k, std::size_t per_node, int node_record,
+                      bool count_at_node, std::vector<int>* nodes, std::vector<double>* vals) {
+  while (k < b.lines.size()) {
+    if (trim(b.lines[k]).empty()) {
+      ++k;
+      continue;
+    }
+    int node = 0;
+    if (!parse_int(b.lines[k], &node))
+      c.fail(record_name(node_record), b.line_no[k],
+             "expected a node number (I10), found '" + std::string(rtrim(b.lines[k])) + "'");
+    const int node_line = count_at_node ? b.line_no[k] : -1;
+    ++k;
+    k = read_values(c, b, k, per_node, node_record + 1, "node " + std::to_string(node), vals, node_line);
+    nodes->push_back(node);
+  }
+}
+
+/// Values (nodes x per node) from the numbers of read_node_values(): per node, real parts or (re, im) pairs.
+Eigen::MatrixXcd node_values(const std::vector<double>& vals, Eigen::Index nn, int values_per_node, bool complex) {
+  const std::size_t per_node = static_cast<std::size_t>(values_per_node) * (complex ? 2 : 1);
+  Eigen::MatrixXcd values(nn, values_per_node);
+  for (Eigen::Index i = 0; i < nn; ++i)
+    for (int j = 0; j < values_per_node; ++j) {
+      const std::size_t at = static_cast<std::size_t>(i) * per_node + static_cast<std::size_t>(complex ? 2 * j : j);
+      values(i, j) = std::complex<double>(vals[at], complex ? vals[at + 1] : 0.0);
+    }
+  return values;
+}
+
 Uff55 read55(const Ctx& c, const Block& b) {
-  if (b.lines.size() < 8)
-    c.fail(record_name(static_cast<int>(b.lines.size()) + 1), b.last_line,
-           "the header has " + std::to_string(b.lines.size()) + " of its 8 records (file truncated?)");
+  require_header(c, b.lines.size(), 8, b.last_line);
   Uff55 d;
-  for (int k = 0; k < 5; ++k) d.id[k] = std::string(rtrim(b.lines[k]));
-  const auto r6 = int_record(c, b.lines[5], b.line_no[5], 6, {10}, 6,
-                             "model type, analysis type, data characteristic, specific data type, data type, values per node");
-  d.model_type = r6[0];
-  d.analysis_type = r6[1];
-  d.data_characteristic = r6[2];
+  const auto r6 =
+      ids_and_types(c, b, 0, "specific data type", &d.id, &d.model_type, &d.analysis_type, &d.data_characteristic);
   d.data_type_code = r6[3];
   if (r6[4] != 2 && r6[4] != 5)
     c.fail(record_name(6), b.line_no[5], "data type (field 5) must be 2 (real) or 5 (complex), found " + std::to_string(r6[4]));
@@ -393,28 +440,9 @@ Uff55 read55(const Ctx& c, const Block& b) {
   d.record8 = r8;
   const int per_node = d.values_per_node * (d.complex ? 2 : 1);
   std::vector<double> vals;
-  std::size_t k = 8;
-  while (k < b.lines.size()) {
-    if (trim(b.lines[k]).empty()) {
-      ++k;
-      continue;
-    }
-    int node = 0;
-    if (!parse_int(b.lines[k], &node))
-      c.fail(record_name(9), b.line_no[k], "expected a node number (I10), found '" + std::string(rtrim(b.lines[k])) + "'");
-    const int node_line = b.line_no[k];
-    ++k;
-    k = read_values(c, b, k, static_cast<std::size_t>(per_node), 10, "node " + std::to_string(node), &vals, node_line);
-    d.nodes.push_back(node);
-  }
+  read_node_values(c, b, 8, static_cast<std::size_t>(per_node), 9, true, &d.nodes, &vals);
   if (!b.closed) c.fail(record_name(10), b.last_line, "the file ends without the closing -1 line (truncated?)");
-  const auto nn = static_cast<Eigen::Index>(d.nodes.size());
-  d.values.resize(nn, d.values_per_node);
-  for (Eigen::Index i = 0; i < nn; ++i)
-    for (int j = 0; j < d.values_per_node; ++j) {
-      const std::size_t at = static_cast<std::size_t>(i * per_node) + (d.complex ? 2 * j : j);
-      d.values(i, j) = std::complex<double>(vals[at], d.complex ? vals[at + 1] : 0.0);
-    }
+  d.values = node_values(vals, static_cast<Eigen::Index>(d.nodes.size()), d.values_per_node, d.complex);
   return d;
 }
 
@@ -543,20 +571,13 @@ UffUnits read164(const Ctx& c, const Block& b) {
 // ---- 2414, 18, 2420 (vendor FE results and coordinate systems) ---------------------------------------------------
 
 Uff2414 read2414(const Ctx& c, const Block& b, std::vector<std::string>* notes) {
-  if (b.lines.size() < 13)
-    c.fail(record_name(static_cast<int>(b.lines.size()) + 1), b.last_line,
-           "the header has " + std::to_string(b.lines.size()) + " of its 13 records (file truncated?)");
+  require_header(c, b.lines.size(), 13, b.last_line);
   Uff2414 d;
   const auto r1 = int_record(c, b.lines[0], b.line_no[0], 1, {10}, 1, "analysis dataset label");
   d.label = r1[0];
   d.name = std::string(rtrim(b.lines[1]));
   d.location = int_record(c, b.lines[2], b.line_no[2], 3, {10}, 1, "dataset location")[0];
-  for (int k = 0; k < 5; ++k) d.id[k] = std::string(rtrim(b.lines[3 + k]));
-  const auto r9 = int_record(c, b.lines[8], b.line_no[8], 9, {10}, 6,
-                             "model type, analysis type, data characteristic, result type, data type, values per node");
-  d.model_type = r9[0];
-  d.analysis_type = r9[1];
-  d.data_characteristic = r9[2];
+  const auto r9 = ids_and_types(c, b, 3, "result type", &d.id, &d.model_type, &d.analysis_type, &d.data_characteristic);
   d.result_type = r9[3];
   d.data_type = r9[4];
   d.values_per_node = r9[5];
@@ -587,27 +608,9 @@ Uff2414 read2414(const Ctx& c, const Block& b, std::vector<std::string>* notes) 
   }
   const std::size_t per_node = static_cast<std::size_t>(d.values_per_node) * (d.complex() ? 2 : 1);
   std::vector<double> vals;
-  std::size_t k = 13;
-  while (k < b.lines.size()) {
-    if (trim(b.lines[k]).empty()) {
-      ++k;
-      continue;
-    }
-    int node = 0;
-    if (!parse_int(b.lines[k], &node))
-      c.fail(record_name(14), b.line_no[k], "expected a node number (I10), found '" + std::string(rtrim(b.lines[k])) + "'");
-    ++k;
-    k = read_values(c, b, k, per_node, 15, "node " + std::to_string(node), &vals);
-    d.nodes.push_back(node);
-  }
+  read_node_values(c, b, 13, per_node, 14, false, &d.nodes, &vals);
   require_closed(c, b, record_name(15));
-  const auto nn = static_cast<Eigen::Index>(d.nodes.size());
-  d.values.resize(nn, d.values_per_node);
-  for (Eigen::Index i = 0; i < nn; ++i)
-    for (int j = 0; j < d.values_per_node; ++j) {
-      const std::size_t at = static_cast<std::size_t>(i) * per_node + static_cast<std::size_t>(d.complex() ? 2 * j : j);
-      d.values(i, j) = std::complex<double>(vals[at], d.complex() ? vals[at + 1] : 0.0);
-    }
+  d.values = node_values(vals, static_cast<Eigen::Index>(d.nodes.size()), d.values_per_node, d.complex());
   return d;
 }
 

@@ -1,5 +1,6 @@
 #include "dynid/mesh/generators.hpp"
 
+#include <array>
 #include <functional>
 #include <map>
 
@@ -35,6 +36,18 @@ void add_member(Model* m, ElementType type, int a, int b, int div, int mat, int 
 
 void check_positive(int v, const char* what) {
   if (v < 1) throw InputError(std::string("frame generator: ") + what + " must be >= 1");
+}
+
+// A frame model's start: its mass type, one material and the column and beam sections (indices in *ids:
+// material, column, beam), after checking the counts common to both generators.
+template <class Spec>
+Model frame_start(const Spec& s, std::array<int, 3>* ids) {
+  check_positive(s.stories, "stories");
+  check_positive(s.divisions, "divisions");
+  Model m;
+  m.set_mass_type(s.mass);
+  *ids = {{m.add_material(s.material), m.add_section(s.column), m.add_section(s.beam)}};
+  return m;
 }
 
 }  // namespace
@@ -89,13 +102,9 @@ long long frame3d_dofs(const Frame3DSpec& s) {
 
 Model make_frame2d(const Frame2DSpec& s) {
   check_positive(s.bays, "bays");
-  check_positive(s.stories, "stories");
-  check_positive(s.divisions, "divisions");
-  Model m;
-  m.set_mass_type(s.mass);
-  const int mat = m.add_material(s.material);
-  const int col = m.add_section(s.column);
-  const int bm = m.add_section(s.beam);
+  std::array<int, 3> ids;
+  Model m = frame_start(s, &ids);
+  const int mat = ids[0], col = ids[1], bm = ids[2];
   auto joint = [&](int i, int j) { return 1 + j * (s.bays + 1) + i; };
   for (int j = 0; j <= s.stories; ++j)
     for (int i = 0; i <= s.bays; ++i) m.add_node(joint(i, j), Eigen::Vector3d(i * s.span, j * s.height, 0));
@@ -116,13 +125,9 @@ Model make_frame2d(const Frame2DSpec& s) {
 Model make_frame3d(const Frame3DSpec& s) {
   check_positive(s.bays_x, "bays_x");
   check_positive(s.bays_y, "bays_y");
-  check_positive(s.stories, "stories");
-  check_positive(s.divisions, "divisions");
-  Model m;
-  m.set_mass_type(s.mass);
-  const int mat = m.add_material(s.material);
-  const int col = m.add_section(s.column);
-  const int bm = m.add_section(s.beam);
+  std::array<int, 3> ids;
+  Model m = frame_start(s, &ids);
+  const int mat = ids[0], col = ids[1], bm = ids[2];
   const int nx = s.bays_x + 1, ny = s.bays_y + 1;
   auto joint = [&](int i, int j, int k) { return 1 + (k * ny + j) * nx + i; };
   for (int k = 0; k <= s.stories; ++k)

@@ -10,8 +10,8 @@ class ElementChange : public Candidate {
   ElementChange(const Model& m, int e, bool mass) : e_(e), eid_(m.elements()[e].id), mass_(mass) {}
   // Springs only change stiffness, point masses only mass.
   static bool applies(const Model& m, int e, bool mass) {
-    const ElementType t = m.elements()[e].type;
-    return t == ElementType::Spring ? !mass : t == ElementType::PointMass ? mass : true;
+    const ElementKind& k = element_kind(m.elements()[e].type);
+    return mass ? k.has_mass() : k.has_stiffness();
   }
   std::string kind() const override { return mass_ ? "element_mass" : "element_stiffness"; }
   std::string physics() const override { return mass_ ? "attached_mass" : "local_stiffness"; }

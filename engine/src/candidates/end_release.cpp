@@ -128,7 +128,7 @@ std::vector<double> member_lengths(const CandidateContext& c) {
 
 // Whether rotation d at a member end is a bending rotation of the member (not a twist about its axis).
 bool bends(const Model& m, int e, Dof d) {
-  if (m.elements()[e].type != ElementType::Frame3D) return true;
+  if (!element_kind(m.elements()[e].type).spatial()) return true;
   const auto& n = m.element_nodes(e);
   const Eigen::Vector3d axis = (m.nodes()[n[1]].x - m.nodes()[n[0]].x).normalized();
   return std::abs(axis[static_cast<int>(d) - 3]) < 0.9;

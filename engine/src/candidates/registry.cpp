@@ -166,7 +166,7 @@ CandidateContext make_context(const Model& model, const ModalData& measured, con
     c.gravity = gravity.normalized();
   } else {
     bool space = false;
-    for (const Element& el : model.elements()) space = space || el.type == ElementType::Frame3D;
+    for (const Element& el : model.elements()) space = space || element_kind(el.type).spatial();
     c.gravity = space ? Eigen::Vector3d(0, 0, -1) : Eigen::Vector3d(0, -1, 0);
   }
   return c;

@@ -75,7 +75,7 @@ CandidateKind shear_deformation_kind() {
             std::vector<std::unique_ptr<Candidate>> out;
             const std::vector<int> all = group_members(*c.model, "");
             bool plane = !all.empty();
-            for (int e : all) plane = plane && c.model->elements()[e].type != ElementType::Frame3D;
+            for (int e : all) plane = plane && !element_kind(c.model->elements()[e].type).spatial();
             if (plane) out.push_back(std::make_unique<ShearDeformation>(*c.model, all));
             return out;
           }};

@@ -62,6 +62,13 @@ struct Search {
     return *find(s);
   }
 
+  // The least misfit of any admissible set fitted so far (or the model's as given).
+  void update_best() {
+    chi2_best = p.chi2_0;
+    for (const auto& [k, f] : cache)
+      if (f.ok && !f.at_bound && f.chi2 < chi2_best) chi2_best = f.chi2;
+  }
+
   double evidence(const SetFit& f) const { return log_evidence(p, f); }
   // Share of the misfit removed, relative to the best any explored set reached (reported).
   double explained(const SetFit& f) const { return explained_share(p, f, chi2_best); }
@@ -162,20 +169,21 @@ SelectionStep step_of(const Search& s, SelectionStep::Action a, const std::strin
   return st;
 }
 
-}  // namespace
+// The set `f` without its k-th effect, and the start values of the others.
+struct Omitted {
+  std::vector<const Candidate*> set;
+  std::vector<Eigen::VectorXd> start;
+};
+Omitted omit(const SetFit& f, std::size_t k) {
+  Omitted o;
+  for (std::size_t j = 0; j < f.set.size(); ++j)
+    if (j != k) o.set.push_back(f.set[j]), o.start.push_back(f.theta[j]);
+  return o;
+}
 
-Selection select(const Problem& p, const std::vector<SetFit>& singles, const FitQuality& before) {
-  Search s{p, before};
-  for (const SetFit& f : singles) s.cache.emplace(Search::key(f.set), f);
-  auto update_best = [&]() {
-    s.chi2_best = p.chi2_0;
-    for (const auto& [k, f] : s.cache)
-      if (f.ok && !f.at_bound && f.chi2 < s.chi2_best) s.chi2_best = f.chi2;
-  };
-  update_best();
-
-  // Starts: the best admissible single candidates telling different stories, each better than the model as given
-  // (one effect of two may not be decisive alone; the explanation it starts must be).
+// Starts: the best admissible single candidates telling different stories, each better than the model as given
+// (one effect of two may not be decisive alone; the explanation it starts must be).
+std::vector<const SetFit*> starts_of(const Search& s, const std::vector<SetFit>& singles) {
   std::vector<const SetFit*> ranked;
   for (const SetFit& f : singles)
     if (s.admissible(f) && s.evidence(f) > 0) ranked.push_back(s.find(f.set));
@@ -183,83 +191,73 @@ Selection select(const Problem& p, const std::vector<SetFit>& singles, const Fit
   std::vector<const SetFit*> starts;
   for (const SetFit* f : ranked) {
     bool fresh = true;
-    for (const SetFit* g : starts) fresh = fresh && !same_story(*p.model, *f->set[0], *g->set[0]);
+    for (const SetFit* g : starts) fresh = fresh && !same_story(*s.p.model, *f->set[0], *g->set[0]);
     if (fresh) starts.push_back(f);
     if (starts.size() >= 3) break;
   }
+  return starts;
+}
 
-  // Explore: grow each start greedily to max_effects (by evidence among admissible sets).
-  std::vector<std::vector<const SetFit*>> chains;
-  for (const SetFit* st : starts) {
-    std::vector<const SetFit*> chain = {st};
-    while (static_cast<int>(chain.back()->set.size()) < p.options.max_effects) {
-      const SetFit& cur = *chain.back();
-      const std::vector<const Candidate*> tries = additions(p, cur);
-      std::vector<std::vector<const Candidate*>> sets;
-      std::vector<std::vector<Eigen::VectorXd>> starts_theta;
-      for (const Candidate* c : tries) {
-        std::vector<const Candidate*> set = cur.set;
-        set.push_back(c);
-        sets.push_back(set);
-        starts_theta.push_back(cur.theta);
-      }
-      s.fit_all(sets, starts_theta);
-      const SetFit* best = nullptr;
-      for (const auto& set : sets) {
-        const SetFit* f = s.find(set);
-        if (s.admissible(*f) && (!best || s.evidence(*f) > s.evidence(*best))) best = f;
-      }
-      if (!best) break;
-      chain.push_back(best);
+// Explore: grow a start greedily to max_effects (by evidence among admissible sets).
+std::vector<const SetFit*> grow(Search& s, const SetFit* start) {
+  std::vector<const SetFit*> chain = {start};
+  while (static_cast<int>(chain.back()->set.size()) < s.p.options.max_effects) {
+    const SetFit& cur = *chain.back();
+    std::vector<std::vector<const Candidate*>> sets;
+    std::vector<std::vector<Eigen::VectorXd>> starts_theta;
+    for (const Candidate* c : additions(s.p, cur)) {
+      std::vector<const Candidate*> set = cur.set;
+      set.push_back(c);
+      sets.push_back(set);
+      starts_theta.push_back(cur.theta);
     }
-    chains.push_back(chain);
-  }
-  update_best();
-
-  // Walk each chain: each step must be worth it, and earlier effects must keep their place. Every state the walk
-  // passes is a result (a chain's start can be a better explanation of its size than where another chain ends).
-  std::vector<ChainResult> results;
-  for (const auto& chain : chains) {
-    ChainResult r;
-    const SetFit* cur = chain[0];
-    r.steps.push_back(step_of(s, SelectionStep::Action::kStart, cur->set[0]->description(), *cur));
-    for (std::size_t j = 1; j < chain.size(); ++j) {
-      const SetFit* next = s.find(chain[j]->set);
-      if (!s.worth(*cur, *next)) break;
-      if (s.evidence(*cur) >= p.options.decisive) results.push_back({cur, r.steps});
-      const Candidate* added = next->set.back();
-      r.steps.push_back(step_of(s, SelectionStep::Action::kAdd, added->description(), *next));
-      cur = next;
-      // Backward elimination: does each earlier effect still earn its place beside the new one?
-      bool removed = false;
-      for (const Candidate* a : std::vector<const Candidate*>(cur->set)) {
-        if (a == added) continue;
-        std::vector<const Candidate*> without;
-        std::vector<Eigen::VectorXd> start;
-        for (std::size_t k = 0; k < cur->set.size(); ++k)
-          if (cur->set[k] != a) without.push_back(cur->set[k]), start.push_back(cur->theta[k]);
-        const SetFit& w = s.fitted(without, start);
-        if (!s.worth(w, *cur) && s.admissible(w)) {
-          r.steps.push_back(step_of(s, SelectionStep::Action::kRemove, a->description(), w));
-          cur = s.find(without);
-          removed = true;
-          break;
-        }
-      }
-      if (removed) break;  // the chain's later effects were grown beside the removed one
+    s.fit_all(sets, starts_theta);
+    const SetFit* best = nullptr;
+    for (const auto& set : sets) {
+      const SetFit* f = s.find(set);
+      if (s.admissible(*f) && (!best || s.evidence(*f) > s.evidence(*best))) best = f;
     }
-    r.fit = cur;
-    if (s.evidence(*cur) >= p.options.decisive) results.push_back(r);
+    if (!best) break;
+    chain.push_back(best);
   }
+  return chain;
+}
 
-  Selection sel;
-  if (results.empty()) {
-    sel.chi2_best = s.chi2_best;
-    sel.eigen_solves = s.solves;
-    return sel;
+// Walk a chain: each step must be worth it, and earlier effects must keep their place. Every decisive state the
+// walk passes is a result (a chain's start can be a better explanation of its size than where another chain ends).
+void walk(Search& s, const std::vector<const SetFit*>& chain, std::vector<ChainResult>& results) {
+  ChainResult r;
+  const SetFit* cur = chain[0];
+  r.steps.push_back(step_of(s, SelectionStep::Action::kStart, cur->set[0]->description(), *cur));
+  for (std::size_t j = 1; j < chain.size(); ++j) {
+    const SetFit* next = s.find(chain[j]->set);
+    if (!s.worth(*cur, *next)) break;
+    if (s.evidence(*cur) >= s.p.options.decisive) results.push_back({cur, r.steps});
+    const Candidate* added = next->set.back();
+    r.steps.push_back(step_of(s, SelectionStep::Action::kAdd, added->description(), *next));
+    cur = next;
+    // Backward elimination: does each earlier effect still earn its place beside the new one?
+    bool removed = false;
+    const std::vector<const Candidate*> set = cur->set;
+    for (std::size_t k = 0; k < set.size() && !removed; ++k) {
+      if (set[k] == added) continue;
+      const Omitted o = omit(*cur, k);
+      const SetFit& w = s.fitted(o.set, o.start);
+      if (!s.worth(w, *cur) && s.admissible(w)) {
+        r.steps.push_back(step_of(s, SelectionStep::Action::kRemove, set[k]->description(), w));
+        cur = s.find(o.set);
+        removed = true;
+      }
+    }
+    if (removed) break;  // the chain's later effects were grown beside the removed one
   }
-  // The explanation: the simplest result, replaced by a larger one only when the extra effects are worth it by
-  // the same rule as a step of a chain; among results of one size, the best evidence.
+  r.fit = cur;
+  if (s.evidence(*cur) >= s.p.options.decisive) results.push_back(r);
+}
+
+// The explanation: the simplest result, replaced by a larger one only when the extra effects are worth it by the
+// same rule as a step of a chain; among results of one size, the best evidence. Moved to the front.
+void choose(const Search& s, std::vector<ChainResult>& results) {
   std::stable_sort(results.begin(), results.end(), [&](const ChainResult& a, const ChainResult& b) {
     if (a.fit->set.size() != b.fit->set.size()) return a.fit->set.size() < b.fit->set.size();
     return s.evidence(*a.fit) > s.evidence(*b.fit);
@@ -268,18 +266,35 @@ Selection select(const Problem& p, const std::vector<SetFit>& singles, const Fit
   for (std::size_t k = 1; k < results.size(); ++k)
     if (results[k].fit->set.size() > results[chosen].fit->set.size() && s.worth(*results[chosen].fit, *results[k].fit)) chosen = k;
   std::swap(results[0], results[chosen]);
+}
+
+}  // namespace
+
+Selection select(const Problem& p, const std::vector<SetFit>& singles, const FitQuality& before) {
+  Search s{p, before};
+  for (const SetFit& f : singles) s.cache.emplace(Search::key(f.set), f);
+  s.update_best();
+  std::vector<std::vector<const SetFit*>> chains;
+  for (const SetFit* st : starts_of(s, singles)) chains.push_back(grow(s, st));
+  s.update_best();
+  std::vector<ChainResult> results;
+  for (const auto& chain : chains) walk(s, chain, results);
+
+  Selection sel;
+  sel.eigen_solves = s.solves;
+  sel.chi2_best = s.chi2_best;
+  if (results.empty()) return sel;
+  choose(s, results);
   sel.fit = *results[0].fit;
   sel.steps = results[0].steps;
+  // Importance: the evidence each effect adds beside the others.
   for (std::size_t k = 0; k < sel.fit.set.size(); ++k) {
     if (sel.fit.set.size() == 1) {
       sel.importance.push_back(s.evidence(sel.fit));
       continue;
     }
-    std::vector<const Candidate*> without;
-    std::vector<Eigen::VectorXd> start;
-    for (std::size_t j = 0; j < sel.fit.set.size(); ++j)
-      if (j != k) without.push_back(sel.fit.set[j]), start.push_back(sel.fit.theta[j]);
-    sel.importance.push_back(s.evidence(sel.fit) - s.evidence(s.fitted(without, start)));
+    const Omitted o = omit(sel.fit, k);
+    sel.importance.push_back(s.evidence(sel.fit) - s.evidence(s.fitted(o.set, o.start)));
   }
   for (std::size_t k = 1; k < results.size(); ++k) sel.alternatives.push_back(*results[k].fit);
   sel.chi2_best = s.chi2_best;

@@ -106,6 +106,12 @@ class ParametricModel {
     bool additive = false;      // scale = theta_p (additive kinds) instead of a product of factors
   };
   void build() const;
+  // build()'s parts: the factor terms of element e (the parts the parameters ps act on), the additive terms.
+  void build_element_terms(int e, const std::vector<int>& ps) const;
+  void build_additive_terms() const;
+  // The CSC position of entry (i, j) of the pattern, or -1 outside it; per (a, b) pair of dofs, row-major.
+  int position(int i, int j) const;
+  std::vector<int> positions(const std::vector<int>& dofs) const;
   double scale(const Term& t, const Eigen::VectorXd& theta) const;
   double dscale(const Term& t, int p, const Eigen::VectorXd& theta) const;
 

@@ -9,7 +9,8 @@
 //   Matrix   an element given by its matrices: any list of (node, DOF type) pairs with stiffness and mass
 //            matrices in global coordinates (element or group matrices exported from another FE code).
 // Each element's global DOF map and its stiffness and mass matrices are available per element
-// (element_dofs(), element_matrices(), element_parts()); sensitivities and residual forces use them.
+// (element_dofs(), element_matrices(), element_parts()); sensitivities and residual forces use them. What each
+// type contributes is its ElementKind (dynid/mesh/element.hpp); Model itself does not switch on the type.
 #pragma once
 
 #include <Eigen/Core>
@@ -21,23 +22,10 @@
 #include <vector>
 
 #include "dynid/mesh/dof.hpp"
+#include "dynid/mesh/element.hpp"
 #include "dynid/mesh/element_source.hpp"
 
 namespace dynid {
-
-namespace internal {
-struct MemberLocal;
-}
-
-enum class ElementType { Beam2D, Frame2D, Frame3D, PointMass, Spring, Matrix };
-/// "beam2d", "frame2d", "frame3d", "point_mass", "spring", "matrix"
-std::string_view element_type_name(ElementType t);
-bool parse_element_type(std::string_view name, ElementType* out);
-/// Beams and frames: two-node members with a section, an axis and bending (the others are point masses,
-/// springs and matrix elements).
-constexpr bool is_member(ElementType t) {
-  return t == ElementType::Beam2D || t == ElementType::Frame2D || t == ElementType::Frame3D;
-}
 
 enum class MassType { Consistent, Lumped };
 
@@ -200,8 +188,7 @@ class Model : public ElementSource {
 
  private:
   void require_finalized(const char* what) const;
-  void finalize_matrix_element(int k, std::vector<DofMask>* active);
-  void member_local(int e, internal::MemberLocal* loc, Eigen::MatrixXd* T, const double* axial_force = nullptr) const;
+  void require_rigid_body_support();
   std::vector<Node> nodes_;
   std::vector<Material> materials_;
   std::vector<Section> sections_;
@@ -209,8 +196,7 @@ class Model : public ElementSource {
   std::unordered_map<int, int> node_of_id_, element_of_id_;
   std::vector<std::pair<int, DofMask>> restraints_;  // (node id, dofs)
   std::vector<std::array<int, 2>> element_nodes_;
-  std::vector<DofMask> point_mass_dofs_;  // per element: DOFs a point mass acts on (set at finalize)
-  std::vector<std::vector<std::pair<int, Dof>>> matrix_dofs_;  // per Matrix element: (node index, DOF type)
+  std::vector<std::vector<std::pair<int, Dof>>> layouts_;  // per element: (node index, DOF type), set at finalize
   std::vector<std::vector<std::pair<int, int>>> matrix_coupling_;  // per sparse Matrix element (element_coupling)
   std::vector<char> matrix_sparse_;
   MassType mass_type_ = MassType::Consistent;
