@@ -13,6 +13,8 @@ namespace dynid {
 
 namespace {
 
+std::vector<double> vec(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+
 bool shares(const std::vector<int>& have, const std::vector<int>& want) {
   for (int w : want)
     if (std::find(have.begin(), have.end(), w) != have.end()) return true;
@@ -118,9 +120,9 @@ nlohmann::ordered_json quality_json(const FitQuality& q) {
   j["unpaired_modes"] = q.unpaired;
   j["mean_mac"] = q.mean_mac;
   j["chi2"] = q.chi2;
-  j["measured_hz"] = std::vector<double>(q.measured_hz.data(), q.measured_hz.data() + q.measured_hz.size());
-  j["model_hz"] = std::vector<double>(q.model_hz.data(), q.model_hz.data() + q.model_hz.size());
-  j["mac"] = std::vector<double>(q.mac.data(), q.mac.data() + q.mac.size());
+  j["measured_hz"] = vec(q.measured_hz);
+  j["model_hz"] = vec(q.model_hz);
+  j["mac"] = vec(q.mac);
   return j;
 }
 
@@ -395,9 +397,8 @@ nlohmann::ordered_json discovery_json(const Case& c, const DiscoveryData& d, con
   j["noise"] = {{"frequency", s.noise.frequency}, {"frequency_source", source(s.noise.frequency_source)},
                 {"shape", s.noise.shape}, {"shape_source", source(s.noise.shape_source)}, {"scale_frequency", s.noise_scale_frequency}, {"scale_shape", s.noise_scale_shape}};
   // Per measured mode used: the frequency noise and its discretization part (relative; empty when not per mode).
-  auto per_mode = [](const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); };
-  j["noise"]["frequency_modes"] = per_mode(s.noise.frequency_modes);
-  j["noise"]["discretization"] = per_mode(s.noise.discretization);
+  j["noise"]["frequency_modes"] = vec(s.noise.frequency_modes);
+  j["noise"]["discretization"] = vec(s.noise.discretization);
   j["set_aside"] = nlohmann::ordered_json::array();
   for (const SetAside& a : s.set_aside)
     j["set_aside"].push_back({{"mode", a.mode + 1}, {"frequency_hz", a.frequency_hz},
