@@ -447,12 +447,27 @@ Eigen::VectorXd projected_frf_power(const FrfData& frf, const Eigen::VectorXcd& 
   return out / uu;
 }
 
-// LSFD at the modes' poles of the windowed data (the window's decay put back): shapes and contributions.
-void lscf_mode_shapes(const LscfInput& in, double window_decay, IdentificationSummary& s) {
+// LSFD at the modes' poles of the windowed data (the window's decay put back): shapes and contributions. The
+// poles of rejected clusters stable over the orders (support >= min_support; not splits, whose mode is reported)
+// join the fit unreported, each more than a half-power bandwidth from every reported mode and from each other: a
+// mode the selection did not report (at a spectral edge, complex, without its own indicator peak) still responds,
+// and left out of the fit its response is taken up by the reported poles near it, whose shapes it makes complex.
+void lscf_mode_shapes(const LscfInput& in, double window_decay, double min_support, IdentificationSummary& s) {
   if (s.modes.empty()) return;
   std::vector<std::complex<double>> poles;
-  for (const IdentifiedMode& m : s.modes)
+  std::vector<std::pair<double, double>> taken;  // (frequency, damping) of the poles in the fit
+  for (const IdentifiedMode& m : s.modes) {
     poles.push_back(internal::pole_of(m.frequency_hz, m.damping_ratio) - window_decay);
+    taken.emplace_back(m.frequency_hz, m.damping_ratio);
+  }
+  for (const RejectedCluster& r : s.rejected) {
+    if (r.reason == Rejection::kSplit || r.reason == Rejection::kFewOrders || r.support < min_support) continue;
+    bool apart = true;
+    for (const auto& [f, z] : taken) apart = apart && std::abs(r.frequency_hz - f) > 2 * std::max(z, r.damping_ratio) * f;
+    if (!apart) continue;
+    poles.push_back(internal::pole_of(r.frequency_hz, r.damping_ratio) - window_decay);
+    taken.emplace_back(r.frequency_hz, r.damping_ratio);
+  }
   const Eigen::MatrixXcd res = lsfd(in.w, in.H, poles);
   double top = 0;
   for (std::size_t r = 0; r < s.modes.size(); ++r) {
@@ -504,7 +519,7 @@ void reject_modes(IdentificationSummary& s, const std::vector<Rejection>& why, c
 void lscf_final_modes(const LscfInput& in, const FrfData& frf_in, double window_decay, const IdentificationOptions& o,
                       IdentificationSummary& s) {
   for (int pass = 0; pass < 4; ++pass) {
-    lscf_mode_shapes(in, window_decay, s);
+    lscf_mode_shapes(in, window_decay, o.min_cluster_fraction, s);
     const std::size_t n = s.modes.size();
     std::vector<char> drop(n, 0);
     std::vector<Rejection> why(n, Rejection::kComplexShape);
@@ -536,7 +551,7 @@ void lscf_final_modes(const LscfInput& in, const FrfData& frf_in, double window_
     if (std::find(drop.begin(), drop.end(), 1) == drop.end()) return;
     reject_modes(s, why, drop, value, limit, into);
   }
-  lscf_mode_shapes(in, window_decay, s);
+  lscf_mode_shapes(in, window_decay, o.min_cluster_fraction, s);
 }
 
 // ---- SSI-cov stages -------------------------------------------------------------------------------------------
