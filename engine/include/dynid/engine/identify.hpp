@@ -202,7 +202,9 @@ IdentificationPlan plan_identification(const FrfData& frf, const IdentificationO
 
 /// LSCF (poly-reference when the FRFs have several inputs) on FRFs; shapes by LSFD with lower and upper
 /// residuals at the selected poles. Any response quantity works (poles do not depend on it); shapes are
-/// residues of the receptance.
+/// residues of the receptance. The LSFD also fits, unreported, the poles of rejected clusters stable over the
+/// orders (support >= min_cluster_fraction, not splits), each more than a half-power bandwidth from the others: a
+/// mode the selection left out still responds, and its response would otherwise make its neighbours complex.
 IdentificationSummary identify_lscf(const FrfData& frf, const IdentificationOptions& options);
 
 /// SSI-cov on the output channels of a recording (all outputs are references; records are concatenated into
