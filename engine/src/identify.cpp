@@ -463,7 +463,8 @@ void lscf_mode_shapes(const LscfInput& in, double window_decay, double min_suppo
   for (const RejectedCluster& r : s.rejected) {
     if (r.reason == Rejection::kSplit || r.reason == Rejection::kFewOrders || r.support < min_support) continue;
     bool apart = true;
-    for (const auto& [f, z] : taken) apart = apart && std::abs(r.frequency_hz - f) > 2 * std::max(z, r.damping_ratio) * f;
+    for (const auto& [f, z] : taken)
+      apart = apart && std::abs(r.frequency_hz - f) > 2 * std::max(z, r.damping_ratio) * f;
     if (!apart) continue;
     poles.push_back(internal::pole_of(r.frequency_hz, r.damping_ratio) - window_decay);
     taken.emplace_back(r.frequency_hz, r.damping_ratio);
