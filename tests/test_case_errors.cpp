@@ -62,6 +62,18 @@ TEST(CaseErrors, ComplexModesLeaveTooFewForDiscovery) {
   EXPECT_EQ(discovery_data(c, m, "rec.uff").measured.num_modes(), 2);
 }
 
+// A misspelled kind in discover's kinds: list is an error naming it, its line and the known kinds (the library would
+// otherwise silently lack the kind the user asked for).
+TEST(CaseErrors, MisspelledDiscoveryKindIsNamed) {
+  const std::string e =
+      Error(std::string(kGood) + "discover:\n  measured: modes.uff\n  kinds: [lumped_mass, semi_rigid_joit]\n");
+  EXPECT_HAS(e, "case.yaml");
+  EXPECT_HAS(e, "unknown candidate kind 'semi_rigid_joit'");
+  EXPECT_HAS(e, "semi_rigid_joint");
+  EXPECT_EQ(Error(std::string(kGood) + "discover:\n  measured: modes.uff\n  kinds: [lumped_mass, semi_rigid_joint]\n"),
+            "(no error)");
+}
+
 TEST(CaseErrors, UnknownElementType) {
   const std::string e = Error(Replace(kGood, "element: frame2d", "element: frame4d"));
   EXPECT_HAS(e, "case.yaml:3:");
