@@ -28,6 +28,15 @@ void report(const EigenOptions& o, std::string_view stage, double f) {
   if (o.progress) o.progress(stage, f);
 }
 
+// Removes a deflation basis P from y (n entries): y <- y - P (Q^T y), with Q = M P for an M-orthonormal P (the
+// generalized operator) or Q = P for an orthonormal one (the standard form). Nothing to do without a basis.
+void deflate(double* y, Eigen::Index n, const Eigen::MatrixXd& P, const Eigen::MatrixXd& Q) {
+  if (P.cols() == 0) return;
+  Eigen::Map<Eigen::VectorXd> yv(y, n);
+  const Eigen::VectorXd c = Q.transpose() * yv;
+  yv.noalias() -= P * c;
+}
+
 // (K - sigma M)^{-1} x on a CHOLMOD factor, meeting Spectra's operator contract (rows, cols, set_shift,
 // perform_op). The factorization is done by the caller before the solver is built, so that failures are
 // reported with the DOF; set_shift only checks the shift. With a deflation basis Phi (M-orthonormal) the result
@@ -45,11 +54,7 @@ class ShiftInvertOperator {
   void perform_op(const double* x, double* y) const {
     f_.solve(x, y);
     ++count_;
-    if (Phi_.cols() > 0) {
-      Eigen::Map<Eigen::VectorXd> yv(y, f_.rows());
-      const Eigen::VectorXd c = MPhi_.transpose() * yv;
-      yv.noalias() -= Phi_ * c;
-    }
+    deflate(y, f_.rows(), Phi_, MPhi_);
   }
   int count() const { return count_; }
 
@@ -106,11 +111,7 @@ class TransformedOperator {
     symmetric_multiply_seq(M_, t_.data(), u_.data());
     f_.forward(u_.data(), y);
     ++count_;
-    if (Y_.cols() > 0) {
-      Eigen::Map<Eigen::VectorXd> yv(y, f_.rows());
-      const Eigen::VectorXd c = Y_.transpose() * yv;
-      yv.noalias() -= Y_ * c;
-    }
+    deflate(y, f_.rows(), Y_, Y_);
   }
   int count() const { return count_; }
 
