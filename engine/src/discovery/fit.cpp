@@ -237,9 +237,11 @@ double log_evidence(const Problem& p, const SetFit& f) {
       occam += lp;
       H(i, i) += prec;
     }
-    // A uniform prior over the kinds and over the kind's sites.
-    const auto it = p.sites_per_kind.find(f.set[c]->kind());
-    occam -= std::log(static_cast<double>(p.kinds)) + std::log(static_cast<double>(it == p.sites_per_kind.end() ? 1 : it->second));
+    // A uniform prior over the physics (Candidate::physics: the kinds that model one effect at different
+    // discretisations share it) and over all the sites of that physics, whichever kind models them.
+    const auto it = p.sites_per_physics.find(f.set[c]->physics());
+    occam -= std::log(static_cast<double>(p.physics)) +
+             std::log(static_cast<double>(it == p.sites_per_physics.end() ? 1 : it->second));
   }
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(H);
   double logdet = 0;

@@ -212,12 +212,8 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
   p.library = place_candidates(p.context, registry, o.kinds);
   for (auto& c : extra) p.library.push_back(std::move(c));
   p.recalibration = make_recalibration(model);
-  std::set<std::string> kinds;
-  for (const auto& c : p.library) {
-    ++p.sites_per_kind[c->kind()];
-    kinds.insert(c->kind());
-  }
-  p.kinds = std::max<int>(1, static_cast<int>(kinds.size()));
+  for (const auto& c : p.library) ++p.sites_per_physics[c->physics()];
+  p.physics = std::max<int>(1, static_cast<int>(p.sites_per_physics.size()));
 }
 
 }  // namespace dynid::internal
