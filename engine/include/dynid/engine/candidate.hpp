@@ -59,8 +59,9 @@ class Candidate {
   virtual std::string kind() const = 0;           ///< "semi_rigid_joint", "lumped_mass", ...
   /// The physics the candidate stands for, shared by the kinds that model one effect at different
   /// discretisations: "attached_mass" for a mass at a node, between the nodes of a member or spread over one
-  /// element; "local_stiffness" for one element or a run of elements stiffer or softer. Discovery weighs the
-  /// stories by it (DiscoverySummary::kind_probability); by default the kind itself.
+  /// element; "local_stiffness" for one element or a run of elements stiffer or softer. Discovery's prior is
+  /// uniform over the physics and over all the sites of each, and it weighs the stories by it
+  /// (DiscoverySummary::kind_probability); by default the kind itself.
   virtual std::string physics() const { return kind(); }
   virtual Nature nature() const = 0;
   virtual std::string description() const = 0;    ///< one line: "rotational spring between element 12 and node 5"
