@@ -38,18 +38,26 @@ class GroundedSpring : public Candidate {
   int eq_ = -1;
 };
 
-// Free DOFs of nodes with elements, except rotations at joints of two or more members (semi_rigid_joint covers
-// those) and, in free-free models, translations (suspension_stiffness covers those).
+// Whether the model restrains some DOF of node n (a support).
+bool supported(const Model& m, int n) {
+  for (int t = 0; t < kNumDofTypes; ++t)
+    if ((m.dof_map().active(n) & (1u << t)) && m.dof_map().eq(n, static_cast<Dof>(t)) < 0) return true;
+  return false;
+}
+
+// Translations: free DOFs of nodes with elements (in free-free models suspension_stiffness covers those).
+// Rotations: free rotations of supported nodes only, a pin's or a roller's partial fixity. Elsewhere a restraint
+// on rotation alone has no counterpart in a structure: what grips a member there restrains it in translation too
+// (grounded_spring), connects through a joint (semi_rigid_joint), or stiffens the member (element_stiffness).
 std::vector<std::unique_ptr<Candidate>> place(const CandidateContext& c, bool rotations) {
   std::vector<std::unique_ptr<Candidate>> out;
   const Model& m = *c.model;
   for (int n = 0; n < static_cast<int>(m.nodes().size()); ++n) {
-    if (!c.node_used[n]) continue;
+    if (!c.node_used[n] || (rotations && !supported(m, n))) continue;
     for (int t = 0; t < kNumDofTypes; ++t) {
       const Dof d = static_cast<Dof>(t);
       const int eq = m.dof_map().eq(n, d);
       if (eq < 0 || is_rotation(d) != rotations) continue;
-      if (rotations && c.member_ends[n].size() >= 2) continue;
       if (!rotations && m.free_free()) continue;
       out.push_back(std::make_unique<GroundedSpring>(m, n, d, c.band_stiffness[eq]));
     }
