@@ -38,13 +38,6 @@ class GroundedSpring : public Candidate {
   int eq_ = -1;
 };
 
-// Whether the model restrains some DOF of node n (a support).
-bool supported(const Model& m, int n) {
-  for (int t = 0; t < kNumDofTypes; ++t)
-    if ((m.dof_map().active(n) & (1u << t)) && m.dof_map().eq(n, static_cast<Dof>(t)) < 0) return true;
-  return false;
-}
-
 // Translations: free DOFs of nodes with elements (in free-free models suspension_stiffness covers those).
 // Rotations: free rotations of supported nodes only, a pin's or a roller's partial fixity. Elsewhere a restraint
 // on rotation alone has no counterpart in a structure: what grips a member there restrains it in translation too
@@ -53,7 +46,8 @@ std::vector<std::unique_ptr<Candidate>> place(const CandidateContext& c, bool ro
   std::vector<std::unique_ptr<Candidate>> out;
   const Model& m = *c.model;
   for (int n = 0; n < static_cast<int>(m.nodes().size()); ++n) {
-    if (!c.node_used[n] || (rotations && !supported(m, n))) continue;
+    const bool supported = (m.dof_map().active(n) & m.dof_map().restrained(n)) != 0;
+    if (!c.node_used[n] || (rotations && !supported)) continue;
     for (int t = 0; t < kNumDofTypes; ++t) {
       const Dof d = static_cast<Dof>(t);
       const int eq = m.dof_map().eq(n, d);

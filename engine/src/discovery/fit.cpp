@@ -240,7 +240,7 @@ double log_evidence(const Problem& p, const SetFit& f) {
     // A uniform prior over the physics (Candidate::physics: the kinds that model one effect at different
     // discretisations share it) and over all the sites of that physics, whichever kind models them.
     const auto it = p.sites_per_physics.find(f.set[c]->physics());
-    occam -= std::log(static_cast<double>(p.physics)) +
+    occam -= std::log(static_cast<double>(std::max<std::size_t>(1, p.sites_per_physics.size()))) +
              std::log(static_cast<double>(it == p.sites_per_physics.end() ? 1 : it->second));
   }
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(H);

@@ -2,7 +2,6 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <set>
 
 #include "candidates/common.hpp"
 #include "candidates/registry.hpp"
@@ -213,7 +212,6 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
   for (auto& c : extra) p.library.push_back(std::move(c));
   p.recalibration = make_recalibration(model);
   for (const auto& c : p.library) ++p.sites_per_physics[c->physics()];
-  p.physics = std::max<int>(1, static_cast<int>(p.sites_per_physics.size()));
 }
 
 }  // namespace dynid::internal

@@ -40,9 +40,8 @@ struct Problem {
   CandidateContext context;
   std::vector<std::unique_ptr<Candidate>> library;
   std::unique_ptr<Candidate> recalibration;
-  /// Candidates in the library per Candidate::physics(), and the number of distinct physics (the evidence's prior).
+  /// Candidates in the library per Candidate::physics() (the evidence's prior over physics and sites).
   std::map<std::string, int> sites_per_physics;
-  int physics = 1;
   int n = 0;                       ///< whitened residuals
   int modes = 0;                   ///< measured modes used
   double chi2_0 = 0;               ///< the model as given: whitened residual sum of squares
