@@ -13,6 +13,12 @@
 // -sqrt(eps) max K_ii/M_ii for a free-free structure, as in solve_eigen), on MUMPS's distributed L D L^T of
 // K - sigma M (or CG + BoomerAMG: EigenOptions::DistributedSolver). PETSc options (e.g. -log_view,
 // -st_mat_mumps_icntl_14 50, -eps_view) come from the PETSC_OPTIONS environment variable.
+//
+// Loading: MPI, PETSc and SLEPc are linked only into the plugin libdynid_distributed.so, which the first call that
+// needs them (start_distributed_runtime, distributed_rank/size, the solves) opens: beside the program, in
+// <prefix>/lib, or where DYNID_DISTRIBUTED_LIBRARY says (docs/distributed.md, "The backend library"). A program that
+// never makes such a call never loads them. If the plugin cannot be opened, those calls throw InternalError naming
+// it and the dynamic linker's message. partition_dofs and launched_with_several_ranks never open it.
 #pragma once
 
 #include <vector>
