@@ -47,9 +47,15 @@ int main(int argc, char** argv) {
   register_commands(app, g);
   if (dynid::launched_with_several_ranks()) {
     // mpirun -n N dynid modal CASE: every rank reads the case; the eigen-solve is distributed (docs/distributed.md).
-    dynid::start_distributed_runtime();
+    // This loads the distributed backend (libdynid_distributed.so: MPI, PETSc, SLEPc) and starts MPI.
+    try {
+      dynid::start_distributed_runtime();
+      g.root = dynid::distributed_rank() == 0;
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "dynid: error: {}\n", e.what());
+      return 3;
+    }
     g.distributed = true;
-    g.root = dynid::distributed_rank() == 0;
     std::string command;
     for (int i = 1; i < argc && command.empty(); ++i)
       if (argv[i][0] != '-') command = argv[i];
