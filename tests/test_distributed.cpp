@@ -7,7 +7,6 @@
 // by MAC > 1 - 1e-10 for simple eigenvalues (a shape error e gives 1 - MAC ~ e^2, so this allows e ~ 1e-5 but the
 // paths agree far closer), the rigid-body subspace as a whole by its gap.
 #include <gtest/gtest.h>
-#include <mpi.h>
 
 #include "dynid/engine/modal.hpp"
 #include "dynid/mesh/generators.hpp"
