@@ -1,6 +1,7 @@
 # ctest install.consumer: installs dynid from the build tree BUILD into WORK/stage, moves the installed tree to
-# WORK/moved (the package must be relocatable), then configures, builds and runs tests/consumer against it.
-#   cmake -DBUILD=... -DSOURCE=... -DWORK=... -P consumer_test.cmake
+# WORK/moved (the package must be relocatable), then configures, builds and runs tests/consumer against it, and runs
+# the installed dynid command under MPIEXEC with 2 ranks: both must open the moved tree's distributed backend.
+#   cmake -DBUILD=... -DSOURCE=... -DWORK=... [-DMPIEXEC=...] -P consumer_test.cmake
 file(REMOVE_RECURSE ${WORK})
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
@@ -11,7 +12,8 @@ function(run)
 endfunction()
 run(${CMAKE_COMMAND} --install ${BUILD} --prefix ${WORK}/stage)
 file(RENAME ${WORK}/stage ${WORK}/moved)
-foreach(f bin/dynid include/dynid/engine/detect.hpp lib/cmake/dynid/dynidConfig.cmake lib/libdynid_io.a)
+foreach(f bin/dynid include/dynid/engine/detect.hpp lib/cmake/dynid/dynidConfig.cmake lib/libdynid_io.a
+        lib/libdynid_distributed.so)
   if(NOT EXISTS ${WORK}/moved/${f})
     message(FATAL_ERROR "the installed package lacks ${f}")
   endif()
@@ -24,5 +26,15 @@ message("${last_output}")
 if(NOT last_output MATCHES "dynid consumer: ok")
   message(FATAL_ERROR "the consumer did not say ok")
 endif()
+if(NOT last_output MATCHES "from ${WORK}/moved/lib/libdynid_distributed.so")
+  message(FATAL_ERROR "the consumer did not open the moved tree's distributed backend")
+endif()
 run(${WORK}/moved/bin/dynid --version)
 message("installed dynid: ${last_output}")
+if(MPIEXEC)
+  run(${MPIEXEC} --allow-run-as-root --oversubscribe -n 2 ${WORK}/moved/bin/dynid modal ${SOURCE}/cases/paper-frame)
+  if(NOT last_output MATCHES "paper-frame .60 DOFs")
+    message(FATAL_ERROR "mpirun -n 2 of the installed dynid printed no modes:\n${last_output}")
+  endif()
+  message("installed dynid under ${MPIEXEC} -n 2: ok")
+endif()
