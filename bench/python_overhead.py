@@ -86,8 +86,12 @@ def main():
             s = r["solver"]
             solver.append(s["time_assembly_s"] + s["time_factorize_s"] + s["time_lanczos_s"])
         mc, mp = statistics.median(cli), statistics.median(py)
+        # Each Python run against the command-line run just before it: the machine's drift cancels in the pair.
+        pairs = sorted(100 * (p / c - 1) for c, p in zip(cli, py))
+        q = statistics.quantiles(pairs, n=4) if len(pairs) > 1 else [pairs[0]] * 3
         print(f"1. modal, whole process (start, read case, solve), median of {a.runs}: command line {mc:.3f} s, "
-              f"Python {mp:.3f} s: {100 * (mp / mc - 1):+.1f} % (target within 5 %)")
+              f"Python {mp:.3f} s: {100 * (mp / mc - 1):+.1f} % (target within 5 %); paired runs: median "
+              f"{q[1]:+.1f} %, quartiles {q[0]:+.1f} to {q[2]:+.1f} %, {sum(x <= 5 for x in pairs)} of {len(pairs)} within 5 %")
         print(f"   modal() call in Python {statistics.median(calls):.3f} s; of which the engine's assembly + factorization "
               f"+ Lanczos {statistics.median(solver):.3f} s; results moved to NumPy without copying")
     # 2. Residual forces on the paper frame, the SHM loop's inner step.
@@ -110,7 +114,7 @@ def main():
     print(f"2. {n} residual-force evaluations on the paper frame (60 DOFs, 4 modes): ResidualForces operator "
           f"{t_op:.3f} s ({1e6 * t_op / n:.1f} us each); residual_forces(K, M, ...) from SciPy matrices {t_fn:.3f} s "
           f"({1e6 * t_fn / n:.1f} us each, converting K and M every call) (target: 1,000 under 1 s)")
-    ok = mp <= 1.05 * mc and t_op * 1000 / n < 1.0
+    ok = statistics.median(pairs) <= 5 and t_op * 1000 / n < 1.0
     print("targets met" if ok else "a target is NOT met")
     return 0
 
