@@ -764,10 +764,6 @@ DetectSummary detect(const Model& model, const ModalData& changed_in, const Dete
   return std::move(run.S);
 }
 
-}  // namespace dynid
-
-namespace dynid {
-
 std::vector<NoiseStudyRow> noise_study(const Model& reference, const Model& changed, int element_id,
                                        const NoiseStudyOptions& o) {
   if (o.trials < 1) throw InputError("noise study: trials must be >= 1");

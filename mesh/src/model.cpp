@@ -58,32 +58,6 @@ std::string describe_rigid(const Eigen::MatrixXd& R6, const Eigen::Vector3d& c, 
   return "rotation about " + axis + " through " + fmt_point(a);
 }
 
-// A matrix element's coupling node by node: the blocks of node pairs with a nonzero K or M entry between them, and
-// every node's own block, as pairs (a, b), a < b, of matrix positions. A group matrix exported from another FE
-// code touches hundreds of DOFs but couples few of them. False (and no pairs) when every pair is coupled.
-bool matrix_coupling(const MatrixElementData& d, const std::vector<std::pair<int, Dof>>& layout, std::size_t num_nodes,
-                     std::vector<std::pair<int, int>>* pairs) {
-  const Eigen::Index n = static_cast<Eigen::Index>(layout.size());
-  std::vector<int> local(num_nodes, -1), node_of(static_cast<std::size_t>(n));
-  int nn = 0;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const int node = layout[static_cast<std::size_t>(i)].first;
-    if (local[node] < 0) local[node] = nn++;
-    node_of[static_cast<std::size_t>(i)] = local[node];
-  }
-  std::vector<char> coupled(static_cast<std::size_t>(nn) * nn, 0);
-  for (Eigen::Index j = 0; j < n; ++j)
-    for (Eigen::Index i = 0; i < n; ++i)
-      if (d.K(i, j) != 0.0 || d.M(i, j) != 0.0 || node_of[i] == node_of[j])
-        coupled[static_cast<std::size_t>(node_of[i]) * nn + node_of[j]] = 1;
-  pairs->clear();
-  for (int b = 1; b < n; ++b)
-    for (int a = 0; a < b; ++a)
-      if (coupled[static_cast<std::size_t>(node_of[a]) * nn + node_of[b]]) pairs->emplace_back(a, b);
-  const bool sparse = static_cast<long long>(pairs->size()) < static_cast<long long>(n) * (n - 1) / 2;
-  if (!sparse) pairs->clear();
-  return sparse;
-}
 }  // namespace
 
 Element make_matrix_element(int id, MatrixElementData data, std::string group) {
@@ -177,8 +151,8 @@ void Model::finalize() {
   if (elements_.empty()) throw InputError("the model has no elements");
   element_nodes_.assign(elements_.size(), {{-1, -1}});
   layouts_.assign(elements_.size(), {});
-  matrix_coupling_.assign(elements_.size(), {});
-  matrix_sparse_.assign(elements_.size(), 0);
+  coupling_.assign(elements_.size(), {});
+  sparse_coupling_.assign(elements_.size(), 0);
   std::vector<DofMask> active(nn, 0), restrained(nn, 0);
   std::vector<char> connected(nn, 0);  // nodes drawn by an element without carrying its DOFs
   for (std::size_t k = 0; k < elements_.size(); ++k) {
@@ -186,9 +160,9 @@ void Model::finalize() {
     element_kind(elements_[k].type).setup({*this, elements_[k], who, &element_nodes_[k], &active, &connected});
   }
   for (std::size_t k = 0; k < elements_.size(); ++k) {
-    layouts_[k] = element_kind(elements_[k].type).layout(*this, static_cast<int>(k), active);
-    if (elements_[k].matrix)
-      matrix_sparse_[k] = matrix_coupling(*elements_[k].matrix, layouts_[k], nodes_.size(), &matrix_coupling_[k]);
+    const ElementKind& kind = element_kind(elements_[k].type);
+    layouts_[k] = kind.layout(*this, static_cast<int>(k), active);
+    sparse_coupling_[k] = kind.coupling(*this, static_cast<int>(k), layouts_[k], &coupling_[k]);
   }
   for (const auto& [id, mask] : restraints_) {
     const int n = node_index(id);
@@ -323,8 +297,8 @@ void Model::element_matrices(int e, Eigen::MatrixXd* K, Eigen::MatrixXd* M) cons
 
 bool Model::element_coupling(int e, std::vector<std::pair<int, int>>* pairs) const {
   require_finalized("element_coupling");
-  *pairs = matrix_coupling_[e];
-  return matrix_sparse_[e] != 0;
+  *pairs = coupling_[e];
+  return sparse_coupling_[e] != 0;
 }
 
 Eigen::MatrixXd Model::rigid_body_motions(std::vector<std::string>* labels) const {

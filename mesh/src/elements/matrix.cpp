@@ -77,6 +77,34 @@ class MatrixElement : public ElementKind {
     return out;
   }
 
+  // Node by node: the blocks of node pairs with a nonzero K or M entry between them, and every node's own block. A
+  // group matrix exported from another FE code touches hundreds of DOFs but couples few of them. False (and no
+  // pairs) when every pair is coupled.
+  bool coupling(const Model& m, int e, const std::vector<std::pair<int, Dof>>& layout,
+                std::vector<std::pair<int, int>>* pairs) const override {
+    const MatrixElementData& d = *m.elements()[e].matrix;
+    const Eigen::Index n = static_cast<Eigen::Index>(layout.size());
+    std::vector<int> local(m.nodes().size(), -1), node_of(static_cast<std::size_t>(n));
+    int nn = 0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const int node = layout[static_cast<std::size_t>(i)].first;
+      if (local[node] < 0) local[node] = nn++;
+      node_of[static_cast<std::size_t>(i)] = local[node];
+    }
+    std::vector<char> coupled(static_cast<std::size_t>(nn) * nn, 0);
+    for (Eigen::Index j = 0; j < n; ++j)
+      for (Eigen::Index i = 0; i < n; ++i)
+        if (d.K(i, j) != 0.0 || d.M(i, j) != 0.0 || node_of[i] == node_of[j])
+          coupled[static_cast<std::size_t>(node_of[i]) * nn + node_of[j]] = 1;
+    pairs->clear();
+    for (int b = 1; b < n; ++b)
+      for (int a = 0; a < b; ++a)
+        if (coupled[static_cast<std::size_t>(node_of[a]) * nn + node_of[b]]) pairs->emplace_back(a, b);
+    const bool sparse = static_cast<long long>(pairs->size()) < static_cast<long long>(n) * (n - 1) / 2;
+    if (!sparse) pairs->clear();
+    return sparse;
+  }
+
   ElementParts parts(const Model& m, int e) const override {
     const Element& el = m.elements()[e];
     ElementParts p;

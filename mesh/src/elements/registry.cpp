@@ -44,6 +44,12 @@ void ElementKind::matrices(const Model& m, int e, Eigen::MatrixXd* K, Eigen::Mat
   if (M) *M = p.M();
 }
 
+bool ElementKind::coupling(const Model&, int, const std::vector<std::pair<int, Dof>>&,
+                           std::vector<std::pair<int, int>>* pairs) const {
+  pairs->clear();
+  return false;
+}
+
 Eigen::MatrixXd ElementKind::unit_geometric_stiffness(const Model& m, int e) const {
   throw InputError("element " + std::to_string(m.elements()[e].id) +
                    ": only beams and frames have a geometric stiffness");

@@ -67,6 +67,11 @@ class ElementKind {
   /// K and M (either may be null). Default: the sums of parts(); a kind may compute them faster, with the same
   /// result.
   virtual void matrices(const Model& m, int e, Eigen::MatrixXd* K, Eigen::MatrixXd* M) const;
+  /// finalize(), after layout(): which pairs (a, b), a < b, of the element's layout positions can hold nonzero
+  /// K or M entries, for an element that couples few of its DOFs (ElementSource::element_coupling). Default: every
+  /// pair (false, no pairs).
+  virtual bool coupling(const Model& m, int e, const std::vector<std::pair<int, Dof>>& layout,
+                        std::vector<std::pair<int, int>>* pairs) const;
 
   // ---- members only (the defaults throw InputError naming the element, or return 0) ------------------------
   /// The consistent geometric stiffness of a unit axial tension (int N'^T N' dx per bending plane).

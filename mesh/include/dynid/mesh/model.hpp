@@ -197,8 +197,8 @@ class Model : public ElementSource {
   std::vector<std::pair<int, DofMask>> restraints_;  // (node id, dofs)
   std::vector<std::array<int, 2>> element_nodes_;
   std::vector<std::vector<std::pair<int, Dof>>> layouts_;  // per element: (node index, DOF type), set at finalize
-  std::vector<std::vector<std::pair<int, int>>> matrix_coupling_;  // per sparse Matrix element (element_coupling)
-  std::vector<char> matrix_sparse_;
+  std::vector<std::vector<std::pair<int, int>>> coupling_;  // per element kind that couples few DOFs (element_coupling)
+  std::vector<char> sparse_coupling_;
   MassType mass_type_ = MassType::Consistent;
   bool rotary_inertia_ = false;
   bool free_free_ = false;
