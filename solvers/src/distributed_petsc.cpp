@@ -79,38 +79,22 @@ int world_size() {
   return s;
 }
 
-// Owned PETSc objects (destroyed in reverse order of creation by their holders).
-struct OwnedMat {
-  OwnedMat() = default;
-  OwnedMat(const OwnedMat&) = delete;
-  OwnedMat& operator=(const OwnedMat&) = delete;
-  Mat m = nullptr;
-  ~OwnedMat() { MatDestroy(&m); }
+// Owned PETSc objects (destroyed in reverse order of creation by their holders): h, destroyed with Destroy.
+template <class T, PetscErrorCode (*Destroy)(T*)>
+struct Owned {
+  Owned() = default;
+  Owned(const Owned&) = delete;
+  Owned& operator=(const Owned&) = delete;
+  ~Owned() { Destroy(&h); }
+  T h = nullptr;
 };
-struct OwnedVec {
-  OwnedVec() = default;
-  OwnedVec(const OwnedVec&) = delete;
-  OwnedVec& operator=(const OwnedVec&) = delete;
-  Vec v = nullptr;
-  ~OwnedVec() { VecDestroy(&v); }
-};
-struct OwnedEps {
-  OwnedEps() = default;
-  OwnedEps(const OwnedEps&) = delete;
-  OwnedEps& operator=(const OwnedEps&) = delete;
-  EPS e = nullptr;
-  ~OwnedEps() { EPSDestroy(&e); }
-};
+using OwnedMat = Owned<Mat, MatDestroy>;
+using OwnedVec = Owned<Vec, VecDestroy>;
+using OwnedEps = Owned<EPS, EPSDestroy>;
+// A scatter to all ranks and the vector it fills (the scatter destroyed first).
 struct OwnedScatter {
-  OwnedScatter() = default;
-  OwnedScatter(const OwnedScatter&) = delete;
-  OwnedScatter& operator=(const OwnedScatter&) = delete;
-  VecScatter s = nullptr;
-  Vec all = nullptr;
-  ~OwnedScatter() {
-    VecScatterDestroy(&s);
-    VecDestroy(&all);
-  }
+  OwnedVec all;
+  Owned<VecScatter, VecScatterDestroy> s;
 };
 
 // This rank's rows of K and M in the distributed numbering (rows [begin, end) of n; column indices global in the
@@ -215,13 +199,13 @@ void fill_local(const LocalSystem& ls, const double* x_old, Vec v) {
 
 // The whole vector v on every rank, in the original numbering.
 void gather(const LocalSystem& ls, Vec v, OwnedScatter* sc, double* x_old) {
-  if (!sc->s) DYNID_PETSC(VecScatterCreateToAll(v, &sc->s, &sc->all));
-  DYNID_PETSC(VecScatterBegin(sc->s, v, sc->all, INSERT_VALUES, SCATTER_FORWARD));
-  DYNID_PETSC(VecScatterEnd(sc->s, v, sc->all, INSERT_VALUES, SCATTER_FORWARD));
+  if (!sc->s.h) DYNID_PETSC(VecScatterCreateToAll(v, &sc->s.h, &sc->all.h));
+  DYNID_PETSC(VecScatterBegin(sc->s.h, v, sc->all.h, INSERT_VALUES, SCATTER_FORWARD));
+  DYNID_PETSC(VecScatterEnd(sc->s.h, v, sc->all.h, INSERT_VALUES, SCATTER_FORWARD));
   const PetscScalar* a = nullptr;
-  DYNID_PETSC(VecGetArrayRead(sc->all, &a));
+  DYNID_PETSC(VecGetArrayRead(sc->all.h, &a));
   for (int i = 0; i < ls.n; ++i) x_old[i] = a[ls.new_of_old[static_cast<std::size_t>(i)]];
-  DYNID_PETSC(VecRestoreArrayRead(sc->all, &a));
+  DYNID_PETSC(VecRestoreArrayRead(sc->all.h, &a));
 }
 
 // The shift scale s0 = sqrt(eps) max_i K_ii / M_ii over all ranks (solve_eigen's free-free shift).
@@ -341,17 +325,17 @@ EigenSolution solve_local_system(const detail::DistributedHost& host, const Loca
                (mumps ? "MUMPS Cholesky" : "CG + BoomerAMG") + ", " + std::to_string(sum.ranks) + " ranks)";
   const int n = ls.n;
   OwnedMat K, M;
-  K.m = make_mat(ls, ls.k);
-  M.m = make_mat(ls, ls.m);
+  K.h = make_mat(ls, ls.k);
+  M.h = make_mat(ls, ls.m);
   MatInfo info;
-  DYNID_PETSC(MatGetInfo(K.m, MAT_GLOBAL_SUM, &info));
+  DYNID_PETSC(MatGetInfo(K.h, MAT_GLOBAL_SUM, &info));
   sum.matrix_nonzeros = static_cast<long long>(info.nz_used);
   PetscReal nK = 0, nM = 0;
-  DYNID_PETSC(MatNorm(K.m, NORM_1, &nK));
-  DYNID_PETSC(MatNorm(M.m, NORM_1, &nM));
+  DYNID_PETSC(MatNorm(K.h, NORM_1, &nK));
+  DYNID_PETSC(MatNorm(M.h, NORM_1, &nM));
   OwnedVec x, kx, mx;
-  DYNID_PETSC(MatCreateVecs(K.m, &x.v, &kx.v));
-  DYNID_PETSC(VecDuplicate(x.v, &mx.v));
+  DYNID_PETSC(MatCreateVecs(K.h, &x.h, &kx.h));
+  DYNID_PETSC(VecDuplicate(x.h, &mx.h));
 
   // Rigid-body modes from the basis: M-orthonormalised (B^T M B from distributed products), exact, deflated.
   const Eigen::Index r = opt.rigid_body_basis.cols();
@@ -359,15 +343,15 @@ EigenSolution solve_local_system(const detail::DistributedHost& host, const Loca
   std::vector<OwnedVec> defl(static_cast<std::size_t>(r));
   if (r > 0) {
     Eigen::MatrixXd G(r, r);
-    for (Eigen::Index j = 0; j < r; ++j) DYNID_PETSC(VecDuplicate(x.v, &defl[static_cast<std::size_t>(j)].v));
+    for (Eigen::Index j = 0; j < r; ++j) DYNID_PETSC(VecDuplicate(x.h, &defl[static_cast<std::size_t>(j)].h));
     for (Eigen::Index j = 0; j < r; ++j) {
-      fill_local(ls, opt.rigid_body_basis.col(j).data(), defl[static_cast<std::size_t>(j)].v);
-      DYNID_PETSC(MatMult(M.m, defl[static_cast<std::size_t>(j)].v, mx.v));
+      fill_local(ls, opt.rigid_body_basis.col(j).data(), defl[static_cast<std::size_t>(j)].h);
+      DYNID_PETSC(MatMult(M.h, defl[static_cast<std::size_t>(j)].h, mx.h));
       for (Eigen::Index i = 0; i < r; ++i) {
         if (i > j) continue;
-        fill_local(ls, opt.rigid_body_basis.col(i).data(), x.v);
+        fill_local(ls, opt.rigid_body_basis.col(i).data(), x.h);
         PetscScalar d = 0;
-        DYNID_PETSC(VecDot(mx.v, x.v, &d));
+        DYNID_PETSC(VecDot(mx.h, x.h, &d));
         G(i, j) = G(j, i) = d;
       }
     }
@@ -376,7 +360,7 @@ EigenSolution solve_local_system(const detail::DistributedHost& host, const Loca
     if (llt.info() != Eigen::Success)
       throw InputError("rigid-body basis: the rigid-body motions have no mass (B^T M B is not positive definite)");
     Phi = llt.matrixL().solve(opt.rigid_body_basis.transpose()).transpose();
-    for (Eigen::Index j = 0; j < r; ++j) fill_local(ls, Phi.col(j).data(), defl[static_cast<std::size_t>(j)].v);
+    for (Eigen::Index j = 0; j < r; ++j) fill_local(ls, Phi.col(j).data(), defl[static_cast<std::size_t>(j)].h);
   }
   const double s0 = shift_scale(ls);
   const int nev = opt.num_modes - static_cast<int>(r);
@@ -388,9 +372,9 @@ EigenSolution solve_local_system(const detail::DistributedHost& host, const Loca
   Eigen::MatrixXd modes(n, 0);
   const int rigid_take = std::min<int>(static_cast<int>(r), opt.num_modes);
   for (int j = 0; j < rigid_take; ++j) {
-    DYNID_PETSC(MatMult(K.m, defl[static_cast<std::size_t>(j)].v, kx.v));
+    DYNID_PETSC(MatMult(K.h, defl[static_cast<std::size_t>(j)].h, kx.h));
     PetscScalar d = 0;
-    DYNID_PETSC(VecDot(kx.v, defl[static_cast<std::size_t>(j)].v, &d));
+    DYNID_PETSC(VecDot(kx.h, defl[static_cast<std::size_t>(j)].h, &d));
     lam.push_back(d);
     rigid.push_back(1);
   }
@@ -405,20 +389,20 @@ EigenSolution solve_local_system(const detail::DistributedHost& host, const Loca
     }
     EpsRun run;
     auto set_up = [&](double s) {
-      EPSDestroy(&run.eps.e);
-      DYNID_PETSC(EPSCreate(PETSC_COMM_WORLD, &run.eps.e));
-      configure(run.eps.e, K.m, M.m, opt, nev, s);
+      EPSDestroy(&run.eps.h);
+      DYNID_PETSC(EPSCreate(PETSC_COMM_WORLD, &run.eps.h));
+      configure(run.eps.h, K.h, M.h, opt, nev, s);
       if (r > 0) {
         std::vector<Vec> vs;
-        for (auto& v : defl) vs.push_back(v.v);
-        DYNID_PETSC(EPSSetDeflationSpace(run.eps.e, static_cast<PetscInt>(r), vs.data()));
+        for (auto& v : defl) vs.push_back(v.h);
+        DYNID_PETSC(EPSSetDeflationSpace(run.eps.h, static_cast<PetscInt>(r), vs.data()));
       }
       const auto tf = Clock::now();
       if (opt.progress) opt.progress("factorize", -1);
-      const PetscErrorCode code = EPSSetUp(run.eps.e);
+      const PetscErrorCode code = EPSSetUp(run.eps.h);
       sum.time_factorize += seconds_since(tf);
       run.why.clear();
-      run.factor_ok = code == 0 && (!mumps || factor_statistics(run.eps.e, &sum, &run.why));
+      run.factor_ok = code == 0 && (!mumps || factor_statistics(run.eps.h, &sum, &run.why));
       if (code != 0) {
         const char* text = nullptr;
         PetscErrorMessage(code, &text, nullptr);
@@ -439,7 +423,7 @@ EigenSolution solve_local_system(const detail::DistributedHost& host, const Loca
     }
     const auto tl = Clock::now();
     if (opt.progress) opt.progress("lanczos", -1);
-    const PetscErrorCode code = EPSSolve(run.eps.e);
+    const PetscErrorCode code = EPSSolve(run.eps.h);
     sum.time_lanczos = seconds_since(tl);
     if (code != 0) {
       const char* text = nullptr;
@@ -449,11 +433,11 @@ EigenSolution solve_local_system(const detail::DistributedHost& host, const Loca
       return sol;
     }
     PetscInt nconv = 0, its = 0, solves = 0;
-    DYNID_PETSC(EPSGetConverged(run.eps.e, &nconv));
-    DYNID_PETSC(EPSGetIterationNumber(run.eps.e, &its));
+    DYNID_PETSC(EPSGetConverged(run.eps.h, &nconv));
+    DYNID_PETSC(EPSGetIterationNumber(run.eps.h, &its));
     ST st = nullptr;
     KSP ksp = nullptr;
-    DYNID_PETSC(EPSGetST(run.eps.e, &st));
+    DYNID_PETSC(EPSGetST(run.eps.h, &st));
     DYNID_PETSC(STGetKSP(st, &ksp));
     DYNID_PETSC(KSPGetTotalIterations(ksp, &solves));
     sum.restarts = static_cast<int>(its);
@@ -468,12 +452,12 @@ EigenSolution solve_local_system(const detail::DistributedHost& host, const Loca
     std::vector<double> buf(static_cast<std::size_t>(n));
     for (int k = 0; k < take; ++k) {
       PetscScalar l = 0;
-      DYNID_PETSC(EPSGetEigenpair(run.eps.e, k, &l, nullptr, x.v, nullptr));
-      DYNID_PETSC(MatMult(M.m, x.v, mx.v));
+      DYNID_PETSC(EPSGetEigenpair(run.eps.h, k, &l, nullptr, x.h, nullptr));
+      DYNID_PETSC(MatMult(M.h, x.h, mx.h));
       PetscScalar xmx = 0;
-      DYNID_PETSC(VecDot(x.v, mx.v, &xmx));
-      DYNID_PETSC(VecScale(x.v, 1.0 / std::sqrt(xmx)));  // mass-normalised
-      gather(ls, x.v, &scatter, buf.data());
+      DYNID_PETSC(VecDot(x.h, mx.h, &xmx));
+      DYNID_PETSC(VecScale(x.h, 1.0 / std::sqrt(xmx)));  // mass-normalised
+      gather(ls, x.h, &scatter, buf.data());
       modes.col(rigid_take + k) = to_vector(buf);
       lam.push_back(l);
       rigid.push_back(0);
@@ -489,14 +473,14 @@ EigenSolution solve_local_system(const detail::DistributedHost& host, const Loca
   const Eigen::Index m = sol.eigenvalues.size();
   sol.residuals.resize(m);
   for (Eigen::Index k = 0; k < m; ++k) {
-    fill_local(ls, sol.modes.col(k).data(), x.v);
-    DYNID_PETSC(MatMult(K.m, x.v, kx.v));
-    DYNID_PETSC(MatMult(M.m, x.v, mx.v));
+    fill_local(ls, sol.modes.col(k).data(), x.h);
+    DYNID_PETSC(MatMult(K.h, x.h, kx.h));
+    DYNID_PETSC(MatMult(M.h, x.h, mx.h));
     PetscReal nkx = 0, nx = 0, nr = 0;
-    DYNID_PETSC(VecNorm(kx.v, NORM_2, &nkx));
-    DYNID_PETSC(VecNorm(x.v, NORM_2, &nx));
-    DYNID_PETSC(VecAXPY(kx.v, -sol.eigenvalues[k], mx.v));
-    DYNID_PETSC(VecNorm(kx.v, NORM_2, &nr));
+    DYNID_PETSC(VecNorm(kx.h, NORM_2, &nkx));
+    DYNID_PETSC(VecNorm(x.h, NORM_2, &nx));
+    DYNID_PETSC(VecAXPY(kx.h, -sol.eigenvalues[k], mx.h));
+    DYNID_PETSC(VecNorm(kx.h, NORM_2, &nr));
     sol.residuals[k] = nr / ((nK + std::abs(sol.eigenvalues[k]) * nM) * nx);
     if (r == 0 && sigma < 0 && opt.allow_singular_stiffness && nkx <= opt.rigid_residual_tolerance * nK * nx)
       sol.rigid_body[k] = 1;
