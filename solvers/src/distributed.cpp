@@ -108,6 +108,17 @@ const detail::DistributedBackend& backend() {
 void assemble(const ElementSource& source, SparseMatrix* K, SparseMatrix* M) { Assembler(source).assemble(K, M); }
 const detail::DistributedHost kHost{&assemble, &detail::finish, &partition_dofs};
 
+// Contiguous blocks of DOFs, one per part (detail::split_evenly): the partition when METIS cannot give one.
+std::vector<int> contiguous_parts(int n, int parts) {
+  std::vector<int> part(static_cast<std::size_t>(n), 0);
+  for (int p = 0; p < parts; ++p) {
+    int b = 0, e = 0;
+    detail::split_evenly(n, parts, p, &b, &e);
+    std::fill(part.begin() + b, part.begin() + e, p);
+  }
+  return part;
+}
+
 void refuse_band(const EigenOptions& options) {
   if (!std::isnan(options.band_lo))
     throw InputError(
@@ -170,14 +181,7 @@ std::vector<int> partition_dofs(const ElementSource& src, int parts) {
     prev = std::move(l);
   }
   idx_t nsv = static_cast<idx_t>(weight.size());
-  if (nsv < parts) {  // fewer supervariables than ranks: contiguous blocks of DOFs
-    for (int p = 0; p < parts; ++p) {
-      int b = 0, e = 0;
-      detail::split_evenly(n, parts, p, &b, &e);
-      std::fill(part.begin() + b, part.begin() + e, p);
-    }
-    return part;
-  }
+  if (nsv < parts) return contiguous_parts(n, parts);  // fewer supervariables than ranks
   // Supervariable graph: two are adjacent if an element carries both.
   std::vector<std::vector<idx_t>> adj(static_cast<std::size_t>(nsv));
   std::vector<idx_t> svs;
@@ -216,12 +220,7 @@ std::vector<int> partition_dofs(const ElementSource& src, int parts) {
   // METIS may leave a part empty on tiny graphs: then contiguous blocks.
   std::vector<int> used(static_cast<std::size_t>(parts), 0);
   for (int p : part) used[static_cast<std::size_t>(p)] = 1;
-  if (std::count(used.begin(), used.end(), 1) < parts)
-    for (int p = 0; p < parts; ++p) {
-      int b = 0, e = 0;
-      detail::split_evenly(n, parts, p, &b, &e);
-      std::fill(part.begin() + b, part.begin() + e, p);
-    }
+  if (std::count(used.begin(), used.end(), 1) < parts) return contiguous_parts(n, parts);
   return part;
 }
 
