@@ -38,6 +38,8 @@ FrfData merge_frfs(std::vector<FrfData> sets) {
 
 namespace {
 
+constexpr double kPi = 3.14159265358979323846;
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
@@ -102,6 +104,21 @@ void split_uncertainty(IdentificationSummary& s, const IdentificationSummary& A,
   }
   s.notes.push_back(fmt("split-data uncertainty: %.0f of %.0f modes found in both halves of the data; ", own, static_cast<double>(n)) +
                     fmt("pooled sigma_f = %.3g x f zeta, shape std %.3g of the largest entry", pool_f, pool_s));
+}
+
+// Stationary-response uncertainty (identify.hpp, header comment): continuous records of total length T give
+// sigma_f / f = sqrt(zeta / (pi f T)) and sigma_zeta / zeta = sqrt(1 / (pi zeta f T)) for every mode.
+void stationary_response_uncertainty(IdentificationSummary& s, const std::vector<Recording>& recs) {
+  double T = 0;
+  for (const Recording& r : recs)
+    for (const Eigen::MatrixXd& x : r.records) T += static_cast<double>(x.rows()) / r.sample_rate_hz;
+  for (IdentifiedMode& m : s.modes) {
+    const double zeta = std::max(m.damping_ratio, 1e-4), f = m.frequency_hz;
+    m.frequency_std_hz = f * std::sqrt(zeta / (kPi * f * T));
+    m.damping_std = zeta * std::sqrt(1.0 / (kPi * zeta * f * T));
+  }
+  s.notes.push_back(fmt("frequency and damping std from the stationary response (%.4g s of records): sigma_f / f = "
+                        "sqrt(zeta / (pi f T)); the split-data spread sets the shapes' std only", T));
 }
 
 // The two halves of the data: alternate records of every recording when each has two or more, else the two
@@ -202,6 +219,7 @@ IdentificationSummary identify_recordings(std::vector<Recording> recs, const std
         const IdentificationSummary a = identify_once(A, method, h, hp), b = identify_once(B, method, h, hp);
         split_uncertainty(s, a, b);
         if (s.uncertainty_halves) s.notes.back() += " (halves: " + how + ")";
+        if (!plan.impulsive) stationary_response_uncertainty(s, recs);
       } catch (const InputError& e) {
         s.notes.push_back(std::string("split-data uncertainty: the halves could not be identified (") + e.what() + "); the spread over model orders is reported");
       }
