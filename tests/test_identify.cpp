@@ -130,6 +130,7 @@ TEST(Uncertainty, ContinuousRecordsFrequencyStdMatchesTheScatterOverRealisations
     o.seed = seed;
     const VirtualTest t = simulate_test(c.model, modes, o);
     const IdentificationSummary id = identify_recordings(t.recordings, "ssi", test::Band(0.3, 8));
+    EXPECT_NEAR(id.stationary_record_s, 300, 1 / 25.6);  // one record of 300 s (to a sample)
     for (int k = 0; k < t.modes.num_modes(); ++k) {
       const double f = t.modes.frequencies_hz[k];
       if (f < 0.3 || f > 8) continue;

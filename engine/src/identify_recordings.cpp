@@ -117,8 +117,11 @@ void stationary_response_uncertainty(IdentificationSummary& s, const std::vector
     m.frequency_std_hz = f * std::sqrt(zeta / (kPi * f * T));
     m.damping_std = zeta * std::sqrt(1.0 / (kPi * zeta * f * T));
   }
-  s.notes.push_back(fmt("frequency and damping std from the stationary response (%.4g s of records): sigma_f / f = "
-                        "sqrt(zeta / (pi f T)); the split-data spread sets the shapes' std only", T));
+  s.stationary_record_s = T;
+  s.notes.push_back(
+      fmt("frequency and damping std from the stationary response (%.4g s of records): sigma_f / f = "
+          "sqrt(zeta / (pi f T)); the split-data spread sets the shapes' std only",
+          T));
 }
 
 // The two halves of the data: alternate records of every recording when each has two or more, else the two

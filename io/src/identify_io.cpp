@@ -20,7 +20,10 @@ nlohmann::ordered_json identification_json(const IdentificationSummary& s) {
   j["seconds"] = s.seconds;
   j["window_decay_removed"] = s.window_decay_removed;
   if (s.uncertainty_halves > 0)
-    j["uncertainty"] = {{"halves", s.uncertainty_halves}, {"pooled_frequency_std", s.pooled_frequency_std}, {"pooled_shape_std", s.pooled_shape_std}};
+    j["uncertainty"] = {{"halves", s.uncertainty_halves},
+                        {"pooled_frequency_std", s.pooled_frequency_std},
+                        {"pooled_shape_std", s.pooled_shape_std},
+                        {"stationary_record_s", s.stationary_record_s}};
   nlohmann::ordered_json modes = modal_data_json(s.modal_data(s.method))["modes"];
   for (std::size_t k = 0; k < s.modes.size(); ++k) {
     const IdentifiedMode& m = s.modes[k];

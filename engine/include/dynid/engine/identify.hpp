@@ -174,6 +174,9 @@ struct IdentificationSummary {
   int uncertainty_halves = 0;          ///< 2 when estimated
   double pooled_frequency_std = 0;     ///< pooled sigma_f / (f zeta) (header comment)
   double pooled_shape_std = 0;         ///< pooled shape std relative to the largest entry
+  /// Continuous records: their total length T (s), from which the modes' frequency and damping std come (header
+  /// comment); 0 when those come from the halves (impacts) or the spread over orders.
+  double stationary_record_s = 0;
   std::vector<std::string> notes;      ///< what the plan and the uncertainty estimate did, in words
   double seconds = 0;
   /// The modes as ModalData (real-normalized shapes, damping, MPC, standard deviations, shape_std).
