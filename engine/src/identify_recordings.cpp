@@ -2,6 +2,7 @@
 // resolution from the data), FRFs + LSCF or SSI-cov, and the split-data uncertainty.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "dynid/engine/frf.hpp"
 #include "dynid/engine/identify.hpp"
@@ -106,21 +107,40 @@ void split_uncertainty(IdentificationSummary& s, const IdentificationSummary& A,
                     fmt("pooled sigma_f = %.3g x f zeta, shape std %.3g of the largest entry", pool_f, pool_s));
 }
 
+// The overlap of each mode with its nearest neighbour among the identified modes: their mean half-power
+// half-bandwidth (zeta_k f_k + zeta_j f_j) / 2 over their distance |f_k - f_j|, the largest over j.
+std::vector<double> modal_overlap(const std::vector<IdentifiedMode>& modes) {
+  std::vector<double> o(modes.size(), 0.0);
+  for (std::size_t k = 0; k < modes.size(); ++k)
+    for (std::size_t j = 0; j < modes.size(); ++j) {
+      if (j == k) continue;
+      const double d = std::abs(modes[k].frequency_hz - modes[j].frequency_hz);
+      const double w =
+          0.5 * (modes[k].damping_ratio * modes[k].frequency_hz + modes[j].damping_ratio * modes[j].frequency_hz);
+      o[k] = std::max(o[k], d > 0 ? w / d : std::numeric_limits<double>::infinity());
+    }
+  return o;
+}
+
 // Stationary-response uncertainty (identify.hpp, header comment): continuous records of total length T give
-// sigma_f / f = sqrt(zeta / (pi f T)) and sigma_zeta / zeta = sqrt(1 / (pi zeta f T)) for every mode.
+// sigma_f / f = sqrt(zeta / (pi f T)) sqrt(1 + (o / kOverlapScale)^2), o the mode's overlap with its nearest
+// neighbour, and sigma_zeta / zeta = sqrt(1 / (pi zeta f T)).
 void stationary_response_uncertainty(IdentificationSummary& s, const std::vector<Recording>& recs) {
+  constexpr double kOverlapScale = 0.3;
   double T = 0;
   for (const Recording& r : recs)
     for (const Eigen::MatrixXd& x : r.records) T += static_cast<double>(x.rows()) / r.sample_rate_hz;
-  for (IdentifiedMode& m : s.modes) {
-    const double zeta = std::max(m.damping_ratio, 1e-4), f = m.frequency_hz;
-    m.frequency_std_hz = f * std::sqrt(zeta / (kPi * f * T));
+  const std::vector<double> overlap = modal_overlap(s.modes);
+  for (std::size_t k = 0; k < s.modes.size(); ++k) {
+    IdentifiedMode& m = s.modes[k];
+    const double zeta = std::max(m.damping_ratio, 1e-4), f = m.frequency_hz, o = overlap[k] / kOverlapScale;
+    m.frequency_std_hz = f * std::sqrt(zeta / (kPi * f * T)) * std::sqrt(1 + o * o);
     m.damping_std = zeta * std::sqrt(1.0 / (kPi * zeta * f * T));
   }
   s.stationary_record_s = T;
   s.notes.push_back(
       fmt("frequency and damping std from the stationary response (%.4g s of records): sigma_f / f = "
-          "sqrt(zeta / (pi f T)); the split-data spread sets the shapes' std only",
+          "sqrt(zeta / (pi f T)), widened where a neighbour overlaps; the split-data spread sets the shapes' std only",
           T));
 }
 
