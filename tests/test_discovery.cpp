@@ -483,6 +483,56 @@ TEST(Candidates, SemiRigidJointsOnlyWhereMembersMeet) {
   EXPECT_EQ(at, joints);
 }
 
+// A preload is a self-stress: only members whose lack of fit meets a restraint can carry one (the axial_preload
+// candidate's placement, group_effects.cpp). The groups that get the candidate, by closed-form statics:
+// - a vertical mast of frame elements clamped at its base expands freely (none); pinned at its top as well, it
+//   carries one (all members);
+// - a beam2d line has no axial DOFs: a cantilever (one support) cannot carry one, a simply supported beam (two) can;
+// - the portal (2 x 2 bays, equal stories): its beams are held by the columns (all members and 'beam'), while an
+//   equal elongation of every column lifts the floors rigidly (no force: 'column' gets none).
+TEST(Candidates, PreloadOnlyWhereALackOfFitMeetsARestraint) {
+  auto preload_groups = [](const Model& m) {
+    std::set<std::string> g;
+    for (const auto& c : candidate_library(m, exact_modes(m, m, 3), DiscoveryOptions{}))
+      if (c->kind() == "axial_preload") g.insert(c->description());
+    return g;
+  };
+  auto mast = [](bool pinned_top) {
+    Model m;
+    m.add_material(steel());
+    Section s;
+    s.name = "s";
+    s.A = 5.38e-3;
+    s.Iz = 5.7e-5;
+    m.add_section(s);
+    for (int k = 0; k <= 6; ++k) m.add_node(k + 1, Eigen::Vector3d(0, 0.5 * k, 0));
+    for (int k = 1; k <= 6; ++k) {
+      Element e;
+      e.id = k;
+      e.node_ids = {{k, k + 1}};
+      e.material = 0;
+      e.section = 0;
+      m.add_element(e);
+    }
+    m.restrain(1, dof_bit(Dof::UX) | dof_bit(Dof::UY) | dof_bit(Dof::RZ));
+    if (pinned_top) m.restrain(7, dof_bit(Dof::UX) | dof_bit(Dof::UY));
+    m.finalize();
+    return m;
+  };
+  const std::set<std::string> none, all = {"axial preload (geometric stiffness) in all members"};
+  EXPECT_EQ(preload_groups(mast(false)), none);
+  EXPECT_EQ(preload_groups(mast(true)), all);
+  BeamSpec b = square_steel_beam(2.0);
+  b.elements = 8;
+  b.support = BeamSupport::Cantilever;
+  EXPECT_EQ(preload_groups(make_beam(b)), none);
+  b.support = BeamSupport::SimplySupported;
+  EXPECT_EQ(preload_groups(make_beam(b)), all);
+  EXPECT_EQ(preload_groups(make_frame2d(portal())),
+            (std::set<std::string>{"axial preload (geometric stiffness) in all members",
+                                   "axial preload (geometric stiffness) in the members of group 'beam'"}));
+}
+
 }  // namespace
 }  // namespace dynid
 

@@ -1,8 +1,11 @@
 // axial_preload and distributed_mass: effects spread over all members or one element group (a tension or
 // compression the model leaves out; non-structural mass such as slabs, cladding, fittings).
 #include <cmath>
+#include <optional>
 
 #include "candidates/common.hpp"
+#include "dynid/engine/modal.hpp"
+#include "dynid/solvers/cholmod.hpp"
 
 namespace dynid::internal {
 namespace {
@@ -140,11 +143,83 @@ std::vector<std::unique_ptr<Candidate>> per_group(const CandidateContext& c) {
   return out;
 }
 
+// Whether the structure can hold a preload in the members `els`. A preload is a self-stress: a lack of fit in
+// those members (fit-up, shrinkage, a tensioned tie) that meets a restraint. Static analysis K u = f of a unit
+// axial strain imposed on them (f = sum K_axial,e u_e^0, u_e^0 the element's free elongation), then the axial
+// force left in them, N_e = E A (elongation / L - 1), against E A (the force when fully restrained). A cantilever,
+// a mast or a beam on a roller expands freely: N = 0 to rounding, so no preload can act there (and a strut
+// bracing it is not mistaken for one). Below 1e-4 of the restrained force the strain needed for any force
+// becomes implausible; rounding stays far below that. Members without axial DOFs (beam2d) cannot say: a
+// preload then needs at least two supported nodes to react against.
+class SelfStress {
+ public:
+  explicit SelfStress(const Model& m) : m_(m) {
+    if (m.free_free() || m.num_dofs() == 0) return;
+    const AssembledSystem sys = assemble_system(m);
+    factor_.emplace();
+    factor_->analyze(sys.K);
+    if (!factor_->factorize(sys.K)) factor_.reset();  // a mechanism: no static state to speak of
+  }
+  bool holds(const std::vector<int>& els) const {
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(m_.num_dofs());
+    std::vector<Eigen::VectorXd> free_elongation;
+    double restrained = 0;
+    for (int e : els) {
+      const auto types = m_.element_dof_types(e);
+      const auto& n = m_.element_nodes(e);
+      const Eigen::Vector3d a = m_.nodes()[n[0]].x, axis = (m_.nodes()[n[1]].x - a).normalized();
+      Eigen::VectorXd u0 = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(types.size()));
+      for (std::size_t i = 0; i < types.size(); ++i) {
+        const int t = static_cast<int>(types[i].second);
+        if (t < 3) u0[static_cast<Eigen::Index>(i)] = (m_.nodes()[types[i].first].x - a).dot(axis) * axis[t];
+      }
+      restrained = std::max(restrained, std::abs(m_.member_axial_force(e, u0)));
+      const Eigen::VectorXd fe = m_.element_parts(e).K_axial * u0;
+      std::vector<int> dofs;
+      m_.element_dofs(e, &dofs);
+      for (std::size_t i = 0; i < dofs.size(); ++i)
+        if (dofs[i] >= 0) f[dofs[i]] += fe[static_cast<Eigen::Index>(i)];
+      free_elongation.push_back(std::move(u0));
+    }
+    if (!(restrained > 0)) {  // no axial DOFs
+      int supported = 0;
+      for (int k = 0; k < static_cast<int>(m_.nodes().size()); ++k) supported += m_.dof_map().restrained(k) != 0;
+      return supported >= 2;
+    }
+    if (!factor_) return true;  // free-free or a mechanism: cannot say, keep the candidate
+    Eigen::VectorXd u(f.size());
+    factor_->solve(f.data(), u.data());
+    double left = 0;
+    for (std::size_t k = 0; k < els.size(); ++k) {
+      std::vector<int> dofs;
+      m_.element_dofs(els[k], &dofs);
+      Eigen::VectorXd ue = -free_elongation[k];
+      for (std::size_t i = 0; i < dofs.size(); ++i)
+        if (dofs[i] >= 0) ue[static_cast<Eigen::Index>(i)] += u[dofs[i]];
+      left = std::max(left, std::abs(m_.member_axial_force(els[k], ue)));
+    }
+    return left > 1e-4 * restrained;
+  }
+
+ private:
+  const Model& m_;
+  std::optional<CholmodFactor> factor_;
+};
+
 }  // namespace
 
 CandidateKind axial_preload_kind() {
   return {"axial_preload", Nature::kStiffness, "an axial force (geometric stiffness) in all members or one group",
-          per_group<AxialPreload>};
+          [](const CandidateContext& c) {
+            std::vector<std::unique_ptr<Candidate>> out;
+            const SelfStress self_stress(*c.model);
+            for (const std::string& g : member_groups(*c.model)) {
+              std::vector<int> els = group_members(*c.model, g);
+              if (!els.empty() && self_stress.holds(els))
+                out.push_back(std::make_unique<AxialPreload>(c, g, std::move(els)));
+            }
+            return out;
+          }};
 }
 
 CandidateKind distributed_mass_kind() {
