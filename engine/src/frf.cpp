@@ -8,7 +8,6 @@
 namespace dynid {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 int order_of(Quantity q) {
   switch (q) {
@@ -179,7 +178,8 @@ FrfData convert_frf(const FrfData& frf, Quantity target) {
   out.frequency_hz = frf.frequency_hz.tail(nf);
   out.H = frf.H.bottomRows(nf);
   if (frf.coherence.size()) out.coherence = frf.coherence.bottomRows(nf);
-  for (Eigen::Index r = 0; r < nf; ++r) out.H.row(r) *= std::pow(std::complex<double>(0, 2 * kPi * out.frequency_hz[r]), k);
+  for (Eigen::Index r = 0; r < nf; ++r)
+    out.H.row(r) *= std::pow(std::complex<double>(0, 2 * M_PI * out.frequency_hz[r]), k);
   return out;
 }
 

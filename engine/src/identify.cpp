@@ -18,7 +18,6 @@ namespace dynid {
 using internal::complex_mac;
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 using Clock = std::chrono::steady_clock;
 
 // Marks modes whose shape repeats a stronger one's nearby (split pairs / duplicates).
@@ -296,7 +295,7 @@ LscfInput lscf_input(const FrfData& frf_in, const IdentificationOptions& o) {
   in.w.resize(nf);
   in.H.resize(nf, frf.H.cols());
   for (Eigen::Index k = 0; k < nf; ++k) {
-    in.w[k] = 2 * kPi * frf.frequency_hz[lines[k]];
+    in.w[k] = 2 * M_PI * frf.frequency_hz[lines[k]];
     in.H.row(k) = frf.H.row(lines[k]);
   }
   in.top = frf.frequency_hz[lines.back()];
@@ -417,13 +416,13 @@ internal::ClusterShape lscf_cluster_shape(const LscfInput& in, const std::vector
     return internal::pole_of(q.frequency_hz, q.damping_ratio) - window_decay;
   };
   const internal::PoleCluster& me = clusters[c];
-  const double zw = me.damping_ratio + window_decay / (2 * kPi * me.frequency_hz);
+  const double zw = me.damping_ratio + window_decay / (2 * M_PI * me.frequency_hz);
   const std::complex<double> pw = windowed(me);
-  const double half_width = std::max(3 * zw * std::abs(pw), 5 * 2 * kPi * resolution_hz);
+  const double half_width = std::max(3 * zw * std::abs(pw), 5 * 2 * M_PI * resolution_hz);
   std::vector<std::complex<double>> others;
   for (std::size_t q = 0; q < clusters.size(); ++q)
     if (q != c && clusters[q].support >= min_share &&
-        std::abs(2 * kPi * clusters[q].frequency_hz - pw.imag()) <= half_width)
+        std::abs(2 * M_PI * clusters[q].frequency_hz - pw.imag()) <= half_width)
       others.push_back(windowed(clusters[q]));
   auto shape = [&](const std::vector<std::complex<double>>& with) {
     return principal(outputs_by_inputs(local_residues(in.w, in.H, pw, with, half_width).transpose(), in.no, in.ni));
@@ -542,7 +541,7 @@ void lscf_final_modes(const LscfInput& in, const FrfData& frf_in, double window_
         const std::size_t c = order[a], h = order[b];
         if (drop[h]) continue;
         const Eigen::VectorXd ind = projected_frf_power(frf_in, s.modes[h].shape);
-        const double zw = s.modes[h].damping_ratio + window_decay / (2 * kPi * s.modes[h].frequency_hz);
+        const double zw = s.modes[h].damping_ratio + window_decay / (2 * M_PI * s.modes[h].frequency_hz);
         const double peak = internal::indicator_evidence(s.frequency_hz, ind, s.modes[h].frequency_hz, zw).peak_db;
         if (internal::is_split(side(c), side(h), peak, s.frequency_hz, ind, o)) {
           drop[c] = 1, why[c] = Rejection::kSplit, into[c] = static_cast<int>(h);

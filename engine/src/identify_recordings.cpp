@@ -39,8 +39,6 @@ FrfData merge_frfs(std::vector<FrfData> sets) {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
@@ -134,8 +132,8 @@ void stationary_response_uncertainty(IdentificationSummary& s, const std::vector
   for (std::size_t k = 0; k < s.modes.size(); ++k) {
     IdentifiedMode& m = s.modes[k];
     const double zeta = std::max(m.damping_ratio, 1e-4), f = m.frequency_hz, o = overlap[k] / kOverlapScale;
-    m.frequency_std_hz = f * std::sqrt(zeta / (kPi * f * T)) * std::sqrt(1 + o * o);
-    m.damping_std = zeta * std::sqrt(1.0 / (kPi * zeta * f * T));
+    m.frequency_std_hz = f * std::sqrt(zeta / (M_PI * f * T)) * std::sqrt(1 + o * o);
+    m.damping_std = zeta * std::sqrt(1.0 / (M_PI * zeta * f * T));
   }
   s.stationary_record_s = T;
   s.notes.push_back(

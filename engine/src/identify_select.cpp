@@ -10,7 +10,6 @@
 namespace dynid::internal {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 // Full weight up to the tolerance, falling linearly to 0 at twice it: continuous, so rounding cannot flip it.
 double ramp(double x) { return std::clamp(2.0 - x, 0.0, 1.0); }
@@ -39,14 +38,14 @@ std::vector<RawPole> discrete_poles(const Eigen::MatrixXd& A, double dt, double 
   return poles;
 }
 
-double pole_hz(std::complex<double> l) { return std::abs(l) / (2 * kPi); }
+double pole_hz(std::complex<double> l) { return std::abs(l) / (2 * M_PI); }
 double pole_zeta(std::complex<double> l) { return -l.real() / std::abs(l); }
 double complex_mac(const Eigen::VectorXcd& a, const Eigen::VectorXcd& b) {
   const double d = a.squaredNorm() * b.squaredNorm();
   return d > 0 ? std::norm(a.dot(b)) / d : 0.0;
 }
 std::complex<double> pole_of(double f, double zeta) {
-  const double w = 2 * kPi * f;
+  const double w = 2 * M_PI * f;
   return {-zeta * w, w * std::sqrt(std::max(0.0, 1 - zeta * zeta))};
 }
 
@@ -462,7 +461,7 @@ void select_modes(const OrderPoles& op, double lo, double hi, const Identificati
     } else {
       own[c] = indicator;
     }
-    const double zw = clusters[c].damping_ratio + decay / (2 * kPi * clusters[c].frequency_hz);
+    const double zw = clusters[c].damping_ratio + decay / (2 * M_PI * clusters[c].frequency_hz);
     peak[c] = indicator_evidence(s.frequency_hz, own[c], clusters[c].frequency_hz, zw);
   }
   make_modes(cands, peak, check_evidence(cands, peak, own, o, op.poles.size(), s), op.poles.size(), s);

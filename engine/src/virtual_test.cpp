@@ -11,7 +11,6 @@
 namespace dynid {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 using Excitation = VirtualTestOptions::Excitation;
 
 // Deterministic per-stream generator: the same (seed, record, stream) always gives the same numbers.
@@ -218,7 +217,7 @@ void impact_recordings(const ModalSimulator& sim, double band_hi, const std::str
       Eigen::MatrixXd F = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(o.inputs.size()));
       for (int k = 0; k < n; ++k) {
         const double t = k * sim.h - t0;
-        if (t > 0 && t < tp) F(k, static_cast<Eigen::Index>(i)) = amp * std::sin(kPi * t / tp);
+        if (t > 0 && t < tp) F(k, static_cast<Eigen::Index>(i)) = amp * std::sin(M_PI * t / tp);
       }
       Eigen::MatrixXd Y(n, sim.ns + 1);
       Y.leftCols(sim.ns) = sim.respond(F);

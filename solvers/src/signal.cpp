@@ -12,7 +12,6 @@ namespace dynid {
 
 namespace {
 std::mutex g_fftw_plan;  // FFTW's planner is not thread-safe; execution is
-constexpr double kPi = 3.14159265358979323846;
 }  // namespace
 
 Eigen::VectorXd make_window(Window w, int n, double param) {
@@ -21,7 +20,7 @@ Eigen::VectorXd make_window(Window w, int n, double param) {
   switch (w) {
     case Window::kRectangular: v.setOnes(); break;
     case Window::kHann:
-      for (int i = 0; i < n; ++i) v[i] = 0.5 - 0.5 * std::cos(2 * kPi * i / n);  // periodic Hann (Welch)
+      for (int i = 0; i < n; ++i) v[i] = 0.5 - 0.5 * std::cos(2 * M_PI * i / n);  // periodic Hann (Welch)
       break;
     case Window::kExponential: {
       if (!(param > 0 && param < 1)) throw InputError("exponential window: the end value must be in (0, 1)");
@@ -174,8 +173,8 @@ Eigen::MatrixXd decimate(const Eigen::MatrixXd& y, int factor) {
   Eigen::VectorXd h(2 * half + 1);
   for (int i = -half; i <= half; ++i) {
     const double x = 2 * fc * i;
-    const double sinc = i == 0 ? 1.0 : std::sin(kPi * x) / (kPi * x);
-    const double win = 0.5 + 0.5 * std::cos(kPi * i / (half + 1));
+    const double sinc = i == 0 ? 1.0 : std::sin(M_PI * x) / (M_PI * x);
+    const double win = 0.5 + 0.5 * std::cos(M_PI * i / (half + 1));
     h[i + half] = 2 * fc * sinc * win;
   }
   h /= h.sum();
