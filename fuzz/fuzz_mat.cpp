@@ -55,7 +55,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       n.groups.push_back({"g", vars[0].name, vars[1].name});
       each([&] { dynid::read_mat_matrix_model(n, nullptr, limits); });
     }
-    each([&] { dynid::read_mat_recording(dynid::MatRecordingNames{path}, limits); });
+    each([&] {
+      dynid::MatRecordingNames r;
+      r.file = path;
+      dynid::read_mat_recording(r, limits);
+    });
     each([&] {
       dynid::MatModalNames m;
       m.file = path;
