@@ -133,12 +133,13 @@ class NonStructuralMass : public OnElements {
   double mass_ = 0, per_length_ = 0;
 };
 
-template <class C>
-std::vector<std::unique_ptr<Candidate>> per_group(const CandidateContext& c) {
+// One candidate C on all members and on each group, for the groups `admits` (elements -> bool) lets through.
+template <class C, class Admits>
+std::vector<std::unique_ptr<Candidate>> per_group(const CandidateContext& c, const Admits& admits) {
   std::vector<std::unique_ptr<Candidate>> out;
   for (const std::string& g : member_groups(*c.model)) {
     std::vector<int> els = group_members(*c.model, g);
-    if (!els.empty()) out.push_back(std::make_unique<C>(c, g, std::move(els)));
+    if (!els.empty() && admits(els)) out.push_back(std::make_unique<C>(c, g, std::move(els)));
   }
   return out;
 }
@@ -163,8 +164,10 @@ class SelfStress {
   bool holds(const std::vector<int>& els) const {
     Eigen::VectorXd f = Eigen::VectorXd::Zero(m_.num_dofs());
     std::vector<Eigen::VectorXd> free_elongation;
+    std::vector<std::vector<int>> element_dofs(els.size());
     double restrained = 0;
-    for (int e : els) {
+    for (std::size_t k = 0; k < els.size(); ++k) {
+      const int e = els[k];
       const auto types = m_.element_dof_types(e);
       const auto& n = m_.element_nodes(e);
       const Eigen::Vector3d a = m_.nodes()[n[0]].x, axis = (m_.nodes()[n[1]].x - a).normalized();
@@ -175,7 +178,7 @@ class SelfStress {
       }
       restrained = std::max(restrained, std::abs(m_.member_axial_force(e, u0)));
       const Eigen::VectorXd fe = m_.element_parts(e).K_axial * u0;
-      std::vector<int> dofs;
+      std::vector<int>& dofs = element_dofs[k];
       m_.element_dofs(e, &dofs);
       for (std::size_t i = 0; i < dofs.size(); ++i)
         if (dofs[i] >= 0) f[dofs[i]] += fe[static_cast<Eigen::Index>(i)];
@@ -191,8 +194,7 @@ class SelfStress {
     factor_->solve(f.data(), u.data());
     double left = 0;
     for (std::size_t k = 0; k < els.size(); ++k) {
-      std::vector<int> dofs;
-      m_.element_dofs(els[k], &dofs);
+      const std::vector<int>& dofs = element_dofs[k];
       Eigen::VectorXd ue = -free_elongation[k];
       for (std::size_t i = 0; i < dofs.size(); ++i)
         if (dofs[i] >= 0) ue[static_cast<Eigen::Index>(i)] += u[dofs[i]];
@@ -211,20 +213,16 @@ class SelfStress {
 CandidateKind axial_preload_kind() {
   return {"axial_preload", Nature::kStiffness, "an axial force (geometric stiffness) in all members or one group",
           [](const CandidateContext& c) {
-            std::vector<std::unique_ptr<Candidate>> out;
             const SelfStress self_stress(*c.model);
-            for (const std::string& g : member_groups(*c.model)) {
-              std::vector<int> els = group_members(*c.model, g);
-              if (!els.empty() && self_stress.holds(els))
-                out.push_back(std::make_unique<AxialPreload>(c, g, std::move(els)));
-            }
-            return out;
+            return per_group<AxialPreload>(c, [&](const std::vector<int>& els) { return self_stress.holds(els); });
           }};
 }
 
 CandidateKind distributed_mass_kind() {
   return {"distributed_mass", Nature::kMass, "non-structural mass spread over all members or one group",
-          per_group<NonStructuralMass>};
+          [](const CandidateContext& c) {
+            return per_group<NonStructuralMass>(c, [](const std::vector<int>&) { return true; });
+          }};
 }
 
 }  // namespace dynid::internal
