@@ -14,18 +14,9 @@ void bending_k(double EI, double L, double phi, double s, Eigen::Matrix4d* k) {
   *k = beam_bending_k<double>(EI, L, phi, s);
 }
 
-void bending_m(double rhoA, double L, double s, Eigen::Matrix4d* m) {
-  const double c = rhoA * L / 420.0, L2 = L * L;
-  *m << 156, 22 * L * s, 54, -13 * L * s,  //
-      22 * L * s, 4 * L2, 13 * L * s, -3 * L2,  //
-      54, 13 * L * s, 156, -22 * L * s,    //
-      -13 * L * s, -3 * L2, -22 * L * s, 4 * L2;
-  *m *= c;
-}
-
-// Rayleigh rotary inertia of a cubic-Hermite beam; with rhoI -> P it is also the consistent geometric stiffness
-// of an axial force P (both are int N'^T N' dx).
-void rotary_m(double rhoI, double L, double s, Eigen::Matrix4d* m) {
+// The consistent geometric stiffness of an axial force P on a cubic-Hermite beam, int N'^T N' dx (with P -> rho I
+// the Rayleigh rotary inertia, beam_mass_coefficients' R0).
+void geometric_k(double rhoI, double L, double s, Eigen::Matrix4d* m) {
   const double c = rhoI / (30.0 * L), L2 = L * L;
   *m << 36, 3 * L * s, -36, 3 * L * s,  //
       3 * L * s, 4 * L2, -3 * L * s, -L2,  //
@@ -65,6 +56,38 @@ void zero_all(int n, MemberLocal* o) {
 
 }  // namespace
 
+std::array<Eigen::Matrix4d, 6> beam_mass_coefficients(double rhoA, double rhoI, double L, double s) {
+  const double L2 = L * L, a = L * s / 4;  // a: the L / 4 of Friedman & Kosmatka's terms, with the plane's sign
+  std::array<Eigen::Matrix4d, 6> c;
+  c[0] << 78, 44 * a, 27, -26 * a,        //
+      44 * a, 2 * L2, 26 * a, -1.5 * L2,  //
+      27, 26 * a, 78, -44 * a,            //
+      -26 * a, -1.5 * L2, -44 * a, 2 * L2;
+  c[1] << 147, 77 * a, 63, -63 * a,         //
+      77 * a, 3.5 * L2, 63 * a, -3.5 * L2,  //
+      63, 63 * a, 147, -77 * a,             //
+      -63 * a, -3.5 * L2, -77 * a, 3.5 * L2;
+  c[2] << 70, 35 * a, 35, -35 * a,            //
+      35 * a, 1.75 * L2, 35 * a, -1.75 * L2,  //
+      35, 35 * a, 70, -35 * a,                //
+      -35 * a, -1.75 * L2, -35 * a, 1.75 * L2;
+  const double b = L * s;
+  c[3] << 36, 3 * b, -36, 3 * b,   //
+      3 * b, 4 * L2, -3 * b, -L2,  //
+      -36, -3 * b, 36, -3 * b,     //
+      3 * b, -L2, -3 * b, 4 * L2;
+  c[4] << 0, -15 * b, 0, -15 * b,        //
+      -15 * b, 5 * L2, 15 * b, -5 * L2,  //
+      0, 15 * b, 0, 15 * b,              //
+      -15 * b, -5 * L2, 15 * b, 5 * L2;
+  c[5] << 0, 0, 0, 0,         //
+      0, 10 * L2, 0, 5 * L2,  //
+      0, 0, 0, 0,             //
+      0, 5 * L2, 0, 10 * L2;
+  for (int j = 0; j < 3; ++j) c[j] *= rhoA * L / 210.0, c[3 + j] *= rhoI / (30.0 * L);
+  return c;
+}
+
 void frame2d_local(const MemberProps& p, MemberLocal* o) {
   zero_all(6, o);
   const double L = p.L;
@@ -74,7 +97,7 @@ void frame2d_local(const MemberProps& p, MemberLocal* o) {
   bending_k(p.EIz, L, p.phiz, 1.0, &b);
   scatter4(b, bi, &o->Kb);
   if (p.P != 0.0) {
-    rotary_m(p.P, L, 1.0, &b);
+    geometric_k(p.P, L, 1.0, &b);
     scatter4(b, bi, &o->Kg);
   }
   const double m = p.rhoA * L;
@@ -83,12 +106,9 @@ void frame2d_local(const MemberProps& p, MemberLocal* o) {
     o->Mt(1, 1) += m / 2;
     o->Mt(4, 4) += m / 2;
   } else {
-    bending_m(p.rhoA, L, 1.0, &b);
-    scatter4(b, bi, &o->Mt);
-    if (p.rotary) {
-      rotary_m(p.rhoIz, L, 1.0, &b);
-      scatter4(b, bi, &o->Mr);
-    }
+    const auto c = beam_mass_coefficients(p.rhoA, p.rhoIz, L, 1.0);
+    scatter4(beam_mass(c, p.phiz, false), bi, &o->Mt);
+    if (p.rotary) scatter4(beam_mass(c, p.phiz, true), bi, &o->Mr);
   }
 }
 
@@ -104,9 +124,9 @@ void frame3d_local(const MemberProps& p, MemberLocal* o) {
   bending_k(p.EIy, L, p.phiy, -1.0, &b);
   scatter4(b, xz, &o->Kb);
   if (p.P != 0.0) {
-    rotary_m(p.P, L, 1.0, &b);
+    geometric_k(p.P, L, 1.0, &b);
     scatter4(b, xy, &o->Kg);
-    rotary_m(p.P, L, -1.0, &b);
+    geometric_k(p.P, L, -1.0, &b);
     scatter4(b, xz, &o->Kg);
   }
   const double m = p.rhoA * L;
@@ -116,15 +136,13 @@ void frame3d_local(const MemberProps& p, MemberLocal* o) {
   if (p.lumped) {
     for (int i : {1, 2, 7, 8}) o->Mt(i, i) += m / 2;
   } else {
-    bending_m(p.rhoA, L, 1.0, &b);
-    scatter4(b, xy, &o->Mt);
-    bending_m(p.rhoA, L, -1.0, &b);
-    scatter4(b, xz, &o->Mt);
+    const auto cz = beam_mass_coefficients(p.rhoA, p.rhoIz, L, 1.0),
+               cy = beam_mass_coefficients(p.rhoA, p.rhoIy, L, -1.0);
+    scatter4(beam_mass(cz, p.phiz, false), xy, &o->Mt);
+    scatter4(beam_mass(cy, p.phiy, false), xz, &o->Mt);
     if (p.rotary) {
-      rotary_m(p.rhoIz, L, 1.0, &b);
-      scatter4(b, xy, &o->Mr);
-      rotary_m(p.rhoIy, L, -1.0, &b);
-      scatter4(b, xz, &o->Mr);
+      scatter4(beam_mass(cz, p.phiz, true), xy, &o->Mr);
+      scatter4(beam_mass(cy, p.phiy, true), xz, &o->Mr);
     }
   }
 }

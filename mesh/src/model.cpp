@@ -280,6 +280,11 @@ Eigen::MatrixXd Model::unit_geometric_stiffness(int e) const {
   return element_kind(elements_[e].type).unit_geometric_stiffness(*this, e);
 }
 
+std::array<Eigen::MatrixXd, 6> Model::member_shear_mass_parts(int e) const {
+  require_finalized("member_shear_mass_parts");
+  return element_kind(elements_[e].type).shear_mass_parts(*this, e);
+}
+
 Eigen::MatrixXd Model::member_point_interpolation(int e, double xi, Eigen::MatrixXd* dN) const {
   require_finalized("member_point_interpolation");
   return element_kind(elements_[e].type).point_interpolation(*this, e, xi, dN);

@@ -3,10 +3,13 @@
 //
 // Per member (plane bending): K_b(alpha) = (K_b + alpha phi0 EI/L d d^T) / (1 + alpha phi0), phi0 = 12 EI/(G A L^2),
 // d = e_t1 - e_t2 on the rotations; alpha = 1/kappa (0 = Euler-Bernoulli), the exact Timoshenko stiffness of the
-// two-node element. The rotary inertia rho I int N'^T N' enters with the weight w(alpha) = 1 - exp(-(alpha /
+// two-node element. Its mass is the one consistent with that stiffness (Model::member_shear_mass_parts, Friedman &
+// Kosmatka): the translational mass of its shape functions and the rotary inertia of the section's rotation (not
+// of the slope w', which shear adds to: the Rayleigh term over-weights rotary inertia in thick members, and a
+// kappa fitted with it came out high). The rotary inertia enters with the weight w(alpha) = 1 - exp(-(alpha /
 // 0.45)^2): none at alpha = 0 (the model as given), over 99 % from alpha = 1 on (kappa <= 1, every real section),
 // so that the candidate is the nominal model at its nominal parameter and Timoshenko's beam where it matters.
-// Models that already include rotary inertia get none added.
+// Models that already include rotary inertia have it replaced by the section rotation's.
 #include <cmath>
 
 #include "candidates/common.hpp"
@@ -38,17 +41,25 @@ class ShearDeformation : public Candidate {
         if (mb.types[k].second == Dof::RZ) d[static_cast<Eigen::Index>(k)] = seen++ == 0 ? 1.0 : -1.0;
       const Eigen::MatrixXd D = (mb.EI / mb.L) * d * d.transpose();
       const double phi0 = 12.0 * mb.EI / (mb.GA * mb.L * mb.L);
-      const Eigen::MatrixXd Mr = m.rotary_inertia() ? Eigen::MatrixXd() : (mb.rhoI * m.unit_geometric_stiffness(e)).eval();
       CustomTerm t;
       t.dofs = mb.dofs;
       t.params = {first};
-      t.eval = [Kb = mb.Kb, D, phi0, Mr](const Eigen::VectorXd& th, Eigen::MatrixXd* dK, Eigen::MatrixXd* dM,
-                                         std::vector<Eigen::MatrixXd>* dKd, std::vector<Eigen::MatrixXd>* dMd) {
-        const double a = th[0], q = 1.0 + a * phi0, x = a / kRotaryRamp, g = std::exp(-x * x);
+      t.eval = [Kb = mb.Kb, D, phi0, P = m.member_shear_mass_parts(e), rotary = m.rotary_inertia()](
+                   const Eigen::VectorXd& th, Eigen::MatrixXd* dK, Eigen::MatrixXd* dM,
+                   std::vector<Eigen::MatrixXd>* dKd, std::vector<Eigen::MatrixXd>* dMd) {
+        const double a = th[0], phi = a * phi0, q = 1.0 + phi, x = a / kRotaryRamp, g = std::exp(-x * x);
+        // (P[o] + phi P[o+1] + phi^2 P[o+2]) / q^2 and its derivative in alpha.
+        auto part = [&](int o) -> Eigen::MatrixXd { return (P[o] + phi * P[o + 1] + phi * phi * P[o + 2]) / (q * q); };
+        auto slope = [&](int o) -> Eigen::MatrixXd {
+          return phi0 * ((P[o + 1] + 2.0 * phi * P[o + 2]) * q - 2.0 * (P[o] + phi * P[o + 1] + phi * phi * P[o + 2])) /
+                 (q * q * q);
+        };
+        // Rotary inertia: replaces the model's (rotary) or enters with the weight w = 1 - g.
+        const double w = rotary ? 1.0 : 1.0 - g, dw = rotary ? 0.0 : 2.0 * x / kRotaryRamp * g;
         if (dK) *dK = (Kb + a * phi0 * D) / q - Kb;
-        if (dM && Mr.size()) *dM = (1.0 - g) * Mr;
+        if (dM) *dM = part(0) - P[0] + w * part(3) - (rotary ? P[3] : Eigen::MatrixXd::Zero(P[3].rows(), P[3].cols()));
         if (dKd) *dKd = {phi0 * (D - Kb) / (q * q)};
-        if (dMd) *dMd = {Mr.size() ? (2.0 * x / kRotaryRamp * g * Mr).eval() : Eigen::MatrixXd()};
+        if (dMd) *dMd = {slope(0) + w * slope(3) + dw * part(3)};
       };
       out.push_back(std::move(t));
     }

@@ -162,6 +162,27 @@ Eigen::MatrixXd MemberKind::unit_geometric_stiffness(const Model& m, int e) cons
   return T.transpose() * loc.Kg * T;
 }
 
+std::array<Eigen::MatrixXd, 6> MemberKind::shear_mass_parts(const Model& m, int e) const {
+  if (spatial()) return ElementKind::shear_mass_parts(m, e);
+  MemberLocal loc;
+  Eigen::MatrixXd T;  // local DOFs from the element's global DOFs
+  local(m, e, &loc, &T);
+  const Element& el = m.elements()[e];
+  const double rho = m.materials()[el.material].rho * el.factors.rho;
+  const Section& sec = m.sections()[el.section];
+  const double L = (m.nodes()[m.element_nodes(e)[1]].x - m.nodes()[m.element_nodes(e)[0]].x).norm();
+  const auto c = beam_mass_coefficients(rho * sec.A * el.factors.A, rho * sec.Iz * el.factors.I, L, 1.0);
+  const std::array<int, 4> bi{{1, 2, 4, 5}};
+  std::array<Eigen::MatrixXd, 6> out;
+  for (int j = 0; j < 6; ++j) {
+    Eigen::MatrixXd l = Eigen::MatrixXd::Zero(6, 6);
+    for (int r = 0; r < 4; ++r)
+      for (int s = 0; s < 4; ++s) l(bi[r], bi[s]) = c[j](r, s);
+    out[j] = T.transpose() * l * T;
+  }
+  return out;
+}
+
 Eigen::MatrixXd MemberKind::point_interpolation(const Model& m, int e, double xi, Eigen::MatrixXd* dN) const {
   MemberLocal loc;
   Eigen::MatrixXd T;  // local DOFs from the element's global DOFs

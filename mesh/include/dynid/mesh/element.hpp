@@ -78,6 +78,8 @@ class ElementKind {
   virtual Eigen::MatrixXd unit_geometric_stiffness(const Model& m, int e) const;
   /// The 3 x n interpolation of the global translation at xi in [0, 1] along the axis (see Model).
   virtual Eigen::MatrixXd point_interpolation(const Model& m, int e, double xi, Eigen::MatrixXd* dN) const;
+  /// Plane members: the bending mass of a shear-deformable element, in six parts (see Model).
+  virtual std::array<Eigen::MatrixXd, 6> shear_mass_parts(const Model& m, int e) const;
   /// The axial force (tension > 0) that element displacements u produce; 0 for elements without axial DOFs.
   virtual double axial_force(const Model& m, int e, const Eigen::VectorXd& u) const;
 };
