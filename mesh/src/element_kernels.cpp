@@ -16,8 +16,8 @@ void bending_k(double EI, double L, double phi, double s, Eigen::Matrix4d* k) {
 
 // The consistent geometric stiffness of an axial force P on a cubic-Hermite beam, int N'^T N' dx (with P -> rho I
 // the Rayleigh rotary inertia, beam_mass_coefficients' R0).
-void geometric_k(double rhoI, double L, double s, Eigen::Matrix4d* m) {
-  const double c = rhoI / (30.0 * L), L2 = L * L;
+void geometric_k(double P, double L, double s, Eigen::Matrix4d* m) {
+  const double c = P / (30.0 * L), L2 = L * L;
   *m << 36, 3 * L * s, -36, 3 * L * s,  //
       3 * L * s, 4 * L2, -3 * L * s, -L2,  //
       -36, -3 * L * s, 36, -3 * L * s,   //

@@ -87,7 +87,8 @@ Eigen::Matrix3d MemberKind::axes(const Model& m, int e) const {
   return R;
 }
 
-void MemberKind::local(const Model& m, int e, MemberLocal* loc, Eigen::MatrixXd* T, const double* axial_force) const {
+void MemberKind::local(const Model& m, int e, MemberLocal* loc, Eigen::MatrixXd* T, const double* axial_force,
+                       MemberProps* props) const {
   const Element& el = m.elements()[e];
   const Material& mat = m.materials()[el.material];
   const Section& sec = m.sections()[el.section];
@@ -121,6 +122,7 @@ void MemberKind::local(const Model& m, int e, MemberLocal* loc, Eigen::MatrixXd*
   T->setZero(3 * blocks, 3 * blocks);
   for (int k = 0; k < blocks; ++k) T->block<3, 3>(3 * k, 3 * k) = R;
   embed(T);
+  if (props) *props = mp;
 }
 
 ElementParts MemberKind::parts(const Model& m, int e) const {
@@ -166,12 +168,9 @@ std::array<Eigen::MatrixXd, 6> MemberKind::shear_mass_parts(const Model& m, int 
   if (spatial()) return ElementKind::shear_mass_parts(m, e);
   MemberLocal loc;
   Eigen::MatrixXd T;  // local DOFs from the element's global DOFs
-  local(m, e, &loc, &T);
-  const Element& el = m.elements()[e];
-  const double rho = m.materials()[el.material].rho * el.factors.rho;
-  const Section& sec = m.sections()[el.section];
-  const double L = (m.nodes()[m.element_nodes(e)[1]].x - m.nodes()[m.element_nodes(e)[0]].x).norm();
-  const auto c = beam_mass_coefficients(rho * sec.A * el.factors.A, rho * sec.Iz * el.factors.I, L, 1.0);
+  MemberProps p;
+  local(m, e, &loc, &T, nullptr, &p);
+  const auto c = beam_mass_coefficients(p.rhoA, p.rhoIz, p.L, 1.0);
   const std::array<int, 4> bi{{1, 2, 4, 5}};
   std::array<Eigen::MatrixXd, 6> out;
   for (int j = 0; j < 6; ++j) {

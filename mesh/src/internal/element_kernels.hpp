@@ -52,10 +52,9 @@ Eigen::Matrix<S, 4, 4> beam_bending_k(double EI, double L, S phi, double s) {
 std::array<Eigen::Matrix4d, 6> beam_mass_coefficients(double rhoA, double rhoI, double L, double s);
 
 /// The translational (rotary = false) or rotary bending mass at shear parameter phi from those coefficients.
-template <class S>
-Eigen::Matrix<S, 4, 4> beam_mass(const std::array<Eigen::Matrix4d, 6>& c, S phi, bool rotary) {
+inline Eigen::Matrix4d beam_mass(const std::array<Eigen::Matrix4d, 6>& c, double phi, bool rotary) {
   const int o = rotary ? 3 : 0;
-  return (c[o].cast<S>() + phi * c[o + 1].cast<S>() + phi * phi * c[o + 2].cast<S>()) / ((1.0 + phi) * (1.0 + phi));
+  return (c[o] + phi * c[o + 1] + phi * phi * c[o + 2]) / ((1.0 + phi) * (1.0 + phi));
 }
 
 void frame2d_local(const MemberProps& p, MemberLocal* out);

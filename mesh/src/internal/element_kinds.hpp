@@ -56,7 +56,8 @@ class MemberKind : public ElementKind {
                               const Eigen::Vector3d& b, double L) const = 0;
   /// Local matrices (`loc`) and the map T from the element's global DOFs to its local DOFs; `axial_force`
   /// overrides the element's preload when not null.
-  void local(const Model& m, int e, MemberLocal* loc, Eigen::MatrixXd* T, const double* axial_force = nullptr) const;
+  void local(const Model& m, int e, MemberLocal* loc, Eigen::MatrixXd* T, const double* axial_force = nullptr,
+             MemberProps* props = nullptr) const;
   /// Rows = local x, y, z axes in global coordinates (2D members: z is the global z).
   Eigen::Matrix3d axes(const Model& m, int e) const;
   /// Maps the frame's T (from (ux, uy, rz) or (ux, uy, uz, rx, ry, rz) per node) to the element's own DOFs.
