@@ -5,6 +5,8 @@
 #include <array>
 #include <cmath>
 
+#include "dynid/mesh/model.hpp"
+
 namespace dynid::internal {
 namespace {
 
@@ -15,7 +17,7 @@ void bending_k(double EI, double L, double phi, double s, Eigen::Matrix4d* k) {
 }
 
 // The consistent geometric stiffness of an axial force P on a cubic-Hermite beam, int N'^T N' dx (with P -> rho I
-// the Rayleigh rotary inertia, beam_mass_coefficients' R0).
+// the Rayleigh rotary inertia, beam_mass_coefficient 3).
 void geometric_k(double P, double L, double s, Eigen::Matrix4d* m) {
   const double c = P / (30.0 * L), L2 = L * L;
   *m << 36, 3 * L * s, -36, 3 * L * s,  //
@@ -56,36 +58,54 @@ void zero_all(int n, MemberLocal* o) {
 
 }  // namespace
 
-std::array<Eigen::Matrix4d, 6> beam_mass_coefficients(double rhoA, double rhoI, double L, double s) {
-  const double L2 = L * L, a = L * s / 4;  // a: the L / 4 of Friedman & Kosmatka's terms, with the plane's sign
-  std::array<Eigen::Matrix4d, 6> c;
-  c[0] << 78, 44 * a, 27, -26 * a,        //
-      44 * a, 2 * L2, 26 * a, -1.5 * L2,  //
-      27, 26 * a, 78, -44 * a,            //
-      -26 * a, -1.5 * L2, -44 * a, 2 * L2;
-  c[1] << 147, 77 * a, 63, -63 * a,         //
-      77 * a, 3.5 * L2, 63 * a, -3.5 * L2,  //
-      63, 63 * a, 147, -77 * a,             //
-      -63 * a, -3.5 * L2, -77 * a, 3.5 * L2;
-  c[2] << 70, 35 * a, 35, -35 * a,            //
-      35 * a, 1.75 * L2, 35 * a, -1.75 * L2,  //
-      35, 35 * a, 70, -35 * a,                //
-      -35 * a, -1.75 * L2, -35 * a, 1.75 * L2;
-  const double b = L * s;
-  c[3] << 36, 3 * b, -36, 3 * b,   //
-      3 * b, 4 * L2, -3 * b, -L2,  //
-      -36, -3 * b, 36, -3 * b,     //
-      3 * b, -L2, -3 * b, 4 * L2;
-  c[4] << 0, -15 * b, 0, -15 * b,        //
-      -15 * b, 5 * L2, 15 * b, -5 * L2,  //
-      0, 15 * b, 0, 15 * b,              //
-      -15 * b, -5 * L2, 15 * b, 5 * L2;
-  c[5] << 0, 0, 0, 0,         //
-      0, 10 * L2, 0, 5 * L2,  //
-      0, 0, 0, 0,             //
-      0, 5 * L2, 0, 10 * L2;
-  for (int j = 0; j < 3; ++j) c[j] *= rhoA * L / 210.0, c[3 + j] *= rhoI / (30.0 * L);
-  return c;
+Eigen::Matrix4d beam_mass_coefficient(int j, double rhoA, double rhoI, double L, double s) {
+  const double L2 = L * L, a = L * s / 4, b = L * s;  // a: the L / 4 of Friedman & Kosmatka's terms, with the sign
+  Eigen::Matrix4d c;
+  switch (j) {
+    case 0:
+      c << 78, 44 * a, 27, -26 * a,           //
+          44 * a, 2 * L2, 26 * a, -1.5 * L2,  //
+          27, 26 * a, 78, -44 * a,            //
+          -26 * a, -1.5 * L2, -44 * a, 2 * L2;
+      break;
+    case 1:
+      c << 147, 77 * a, 63, -63 * a,            //
+          77 * a, 3.5 * L2, 63 * a, -3.5 * L2,  //
+          63, 63 * a, 147, -77 * a,             //
+          -63 * a, -3.5 * L2, -77 * a, 3.5 * L2;
+      break;
+    case 2:
+      c << 70, 35 * a, 35, -35 * a,               //
+          35 * a, 1.75 * L2, 35 * a, -1.75 * L2,  //
+          35, 35 * a, 70, -35 * a,                //
+          -35 * a, -1.75 * L2, -35 * a, 1.75 * L2;
+      break;
+    case 3:
+      c << 36, 3 * b, -36, 3 * b,      //
+          3 * b, 4 * L2, -3 * b, -L2,  //
+          -36, -3 * b, 36, -3 * b,     //
+          3 * b, -L2, -3 * b, 4 * L2;
+      break;
+    case 4:
+      c << 0, -15 * b, 0, -15 * b,           //
+          -15 * b, 5 * L2, 15 * b, -5 * L2,  //
+          0, 15 * b, 0, 15 * b,              //
+          -15 * b, -5 * L2, 15 * b, 5 * L2;
+      break;
+    default:
+      c << 0, 0, 0, 0,            //
+          0, 10 * L2, 0, 5 * L2,  //
+          0, 0, 0, 0,             //
+          0, 5 * L2, 0, 10 * L2;
+  }
+  return c * (j < 3 ? rhoA * L / 210.0 : rhoI / (30.0 * L));
+}
+
+Eigen::Matrix4d beam_mass(double rhoA, double rhoI, double L, double phi, double s, bool rotary) {
+  const int o = rotary ? 3 : 0;
+  auto c = [&](int j) { return beam_mass_coefficient(j, rhoA, rhoI, L, s); };
+  if (phi == 0.0) return c(o);
+  return shear_mass<Eigen::Matrix4d>(c(o), c(o + 1), c(o + 2), phi);
 }
 
 void frame2d_local(const MemberProps& p, MemberLocal* o) {
@@ -106,9 +126,8 @@ void frame2d_local(const MemberProps& p, MemberLocal* o) {
     o->Mt(1, 1) += m / 2;
     o->Mt(4, 4) += m / 2;
   } else {
-    const auto c = beam_mass_coefficients(p.rhoA, p.rhoIz, L, 1.0);
-    scatter4(beam_mass(c, p.phiz, false), bi, &o->Mt);
-    if (p.rotary) scatter4(beam_mass(c, p.phiz, true), bi, &o->Mr);
+    scatter4(beam_mass(p.rhoA, p.rhoIz, L, p.phiz, 1.0, false), bi, &o->Mt);
+    if (p.rotary) scatter4(beam_mass(p.rhoA, p.rhoIz, L, p.phiz, 1.0, true), bi, &o->Mr);
   }
 }
 
@@ -136,13 +155,11 @@ void frame3d_local(const MemberProps& p, MemberLocal* o) {
   if (p.lumped) {
     for (int i : {1, 2, 7, 8}) o->Mt(i, i) += m / 2;
   } else {
-    const auto cz = beam_mass_coefficients(p.rhoA, p.rhoIz, L, 1.0),
-               cy = beam_mass_coefficients(p.rhoA, p.rhoIy, L, -1.0);
-    scatter4(beam_mass(cz, p.phiz, false), xy, &o->Mt);
-    scatter4(beam_mass(cy, p.phiy, false), xz, &o->Mt);
+    scatter4(beam_mass(p.rhoA, p.rhoIz, L, p.phiz, 1.0, false), xy, &o->Mt);
+    scatter4(beam_mass(p.rhoA, p.rhoIy, L, p.phiy, -1.0, false), xz, &o->Mt);
     if (p.rotary) {
-      scatter4(beam_mass(cz, p.phiz, true), xy, &o->Mr);
-      scatter4(beam_mass(cy, p.phiy, true), xz, &o->Mr);
+      scatter4(beam_mass(p.rhoA, p.rhoIz, L, p.phiz, 1.0, true), xy, &o->Mr);
+      scatter4(beam_mass(p.rhoA, p.rhoIy, L, p.phiy, -1.0, true), xz, &o->Mr);
     }
   }
 }

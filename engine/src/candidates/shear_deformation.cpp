@@ -48,8 +48,8 @@ class ShearDeformation : public Candidate {
                    const Eigen::VectorXd& th, Eigen::MatrixXd* dK, Eigen::MatrixXd* dM,
                    std::vector<Eigen::MatrixXd>* dKd, std::vector<Eigen::MatrixXd>* dMd) {
         const double a = th[0], phi = a * phi0, q = 1.0 + phi, x = a / kRotaryRamp, g = std::exp(-x * x);
-        // (P[o] + phi P[o+1] + phi^2 P[o+2]) / q^2 and its derivative in alpha.
-        auto part = [&](int o) -> Eigen::MatrixXd { return (P[o] + phi * P[o + 1] + phi * phi * P[o + 2]) / (q * q); };
+        // The mass part at phi (shear_mass) and its derivative in alpha.
+        auto part = [&](int o) -> Eigen::MatrixXd { return shear_mass(P[o], P[o + 1], P[o + 2], phi); };
         auto slope = [&](int o) -> Eigen::MatrixXd {
           return phi0 * ((P[o + 1] + 2.0 * phi * P[o + 2]) * q - 2.0 * (P[o] + phi * P[o + 1] + phi * phi * P[o + 2])) /
                  (q * q * q);

@@ -170,13 +170,13 @@ std::array<Eigen::MatrixXd, 6> MemberKind::shear_mass_parts(const Model& m, int 
   Eigen::MatrixXd T;  // local DOFs from the element's global DOFs
   MemberProps p;
   local(m, e, &loc, &T, nullptr, &p);
-  const auto c = beam_mass_coefficients(p.rhoA, p.rhoIz, p.L, 1.0);
   const std::array<int, 4> bi{{1, 2, 4, 5}};
   std::array<Eigen::MatrixXd, 6> out;
   for (int j = 0; j < 6; ++j) {
+    const Eigen::Matrix4d c = beam_mass_coefficient(j, p.rhoA, p.rhoIz, p.L, 1.0);
     Eigen::MatrixXd l = Eigen::MatrixXd::Zero(6, 6);
     for (int r = 0; r < 4; ++r)
-      for (int s = 0; s < 4; ++s) l(bi[r], bi[s]) = c[j](r, s);
+      for (int s = 0; s < 4; ++s) l(bi[r], bi[s]) = c(r, s);
     out[j] = T.transpose() * l * T;
   }
   return out;

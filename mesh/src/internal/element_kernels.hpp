@@ -3,7 +3,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <array>
 
 namespace dynid::internal {
 
@@ -11,7 +10,7 @@ namespace dynid::internal {
 /// 2D (beam/frame, 6x6, order u1 w1 t1 u2 w2 t2): Kb uses EI = E*Iz, Mr the rotary inertia rho*Iz.
 /// 3D (12x12, order u v w tx ty tz per node): Kb uses E*Iy and E*Iz, Kt uses G*J, Mr holds torsional inertia
 /// rho*(Iy+Iz) always and the bending rotary inertia when `rotary` is set. With shear deformation (phi > 0) the
-/// bending masses are the Timoshenko element's (beam_mass_coefficients), else the cubic-Hermite ones.
+/// bending masses are the Timoshenko element's (beam_mass), else the cubic-Hermite ones.
 struct MemberProps {
   double L = 0;
   double EA = 0, EIy = 0, EIz = 0, GJ = 0;
@@ -47,15 +46,13 @@ Eigen::Matrix<S, 4, 4> beam_bending_k(double EI, double L, S phi, double s) {
 /// stiffness exact (Friedman & Kosmatka, "An improved two-node Timoshenko beam finite element", Computers &
 /// Structures 47, 1993): translational rho A L / 210 (C0 + phi C1 + phi^2 C2) / (1 + phi)^2 and rotary (section
 /// rotation t, not w') rho I / (30 L) (R0 + phi R1 + phi^2 R2) / (1 + phi)^2. At phi = 0 they are the cubic-Hermite
-/// mass and the Rayleigh rotary inertia. coefficients[j] = C_j (translational) and coefficients[3 + j] = R_j
-/// (rotary), already scaled by rho A L / 210 and rho I / (30 L); s as for beam_bending_k.
-std::array<Eigen::Matrix4d, 6> beam_mass_coefficients(double rhoA, double rhoI, double L, double s);
+/// mass and the Rayleigh rotary inertia. Coefficient j = C_j (j = 0, 1, 2: translational) or R_{j-3} (j = 3, 4, 5:
+/// rotary), already scaled by rho A L / 210 or rho I / (30 L); s as for beam_bending_k.
+Eigen::Matrix4d beam_mass_coefficient(int j, double rhoA, double rhoI, double L, double s);
 
-/// The translational (rotary = false) or rotary bending mass at shear parameter phi from those coefficients.
-inline Eigen::Matrix4d beam_mass(const std::array<Eigen::Matrix4d, 6>& c, double phi, bool rotary) {
-  const int o = rotary ? 3 : 0;
-  return (c[o] + phi * c[o + 1] + phi * phi * c[o + 2]) / ((1.0 + phi) * (1.0 + phi));
-}
+/// The translational (rotary = false) or rotary bending mass at shear parameter phi (shear_mass of those
+/// coefficients; at phi = 0 the cubic-Hermite one alone).
+Eigen::Matrix4d beam_mass(double rhoA, double rhoI, double L, double phi, double s, bool rotary);
 
 void frame2d_local(const MemberProps& p, MemberLocal* out);
 void frame3d_local(const MemberProps& p, MemberLocal* out);

@@ -107,6 +107,13 @@ struct ElementParts {
   Eigen::MatrixXd M() const;
 };
 
+/// The Timoshenko bending mass at shear parameter phi from three parts (Model::member_shear_mass_parts' P[0..2]
+/// for the translational mass, P[3..5] for the rotary one): (c0 + phi c1 + phi^2 c2) / (1 + phi)^2.
+template <class Mat>
+Mat shear_mass(const Mat& c0, const Mat& c1, const Mat& c2, double phi) {
+  return (c0 + phi * c1 + phi * phi * c2) / ((1.0 + phi) * (1.0 + phi));
+}
+
 /// The structural model. Build it with the add_* functions, then call finalize(), which validates everything,
 /// resolves node ids and numbers the DOFs. After finalize() the model is an ElementSource.
 class Model : public ElementSource {
