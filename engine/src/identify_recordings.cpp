@@ -65,6 +65,10 @@ const IdentifiedMode* partner(const IdentifiedMode& m, const IdentificationSumma
   return best;
 }
 
+// The share of the spread over orders that the frequency's std keeps beside the halves' spread (identify.hpp,
+// header comment): the error the halves have in common.
+constexpr double kOrderShare = 0.25;
+
 // Split-data uncertainty (identify.hpp, header comment) from the identifications of the two halves.
 void split_uncertainty(IdentificationSummary& s, const IdentificationSummary& A, const IdentificationSummary& B) {
   const std::size_t n = s.modes.size();
@@ -96,13 +100,13 @@ void split_uncertainty(IdentificationSummary& s, const IdentificationSummary& A,
   for (std::size_t k = 0; k < n; ++k) {
     IdentifiedMode& m = s.modes[k];
     const double zeta = std::max(m.damping_ratio, 1e-4);
-    m.frequency_std_hz = m.frequency_hz * zeta * std::max(ef[k], pool_f);
+    m.frequency_std_hz = std::hypot(m.frequency_hz * zeta * std::max(ef[k], pool_f), kOrderShare * m.order_frequency_std_hz);
     m.damping_std = zeta * std::max(ez[k], pool_z);
     m.shape_std = std::max(es[k], pool_s);
     own += ef[k] >= 0;
   }
   s.notes.push_back(fmt("split-data uncertainty: %.0f of %.0f modes found in both halves of the data; ", own, static_cast<double>(n)) +
-                    fmt("pooled sigma_f = %.3g x f zeta, shape std %.3g of the largest entry", pool_f, pool_s));
+                    fmt("pooled sigma_f = %.3g x f zeta (with %.2g of the spread over orders), shape std %.3g of the largest entry", pool_f, kOrderShare, pool_s));
 }
 
 // The overlap of each mode with its nearest neighbour among the identified modes: their mean half-power
@@ -122,7 +126,7 @@ std::vector<double> modal_overlap(const std::vector<IdentifiedMode>& modes) {
 
 // Stationary-response uncertainty (identify.hpp, header comment): continuous records of total length T give
 // sigma_f / f = sqrt(zeta / (pi f T)) sqrt(1 + (o / kOverlapScale)^2), o the mode's overlap with its nearest
-// neighbour, and sigma_zeta / zeta = sqrt(1 / (pi zeta f T)).
+// neighbour, combined with kOrderShare of the spread over orders, and sigma_zeta / zeta = sqrt(1 / (pi zeta f T)).
 void stationary_response_uncertainty(IdentificationSummary& s, const std::vector<Recording>& recs) {
   constexpr double kOverlapScale = 0.3;
   double T = 0;
@@ -132,14 +136,15 @@ void stationary_response_uncertainty(IdentificationSummary& s, const std::vector
   for (std::size_t k = 0; k < s.modes.size(); ++k) {
     IdentifiedMode& m = s.modes[k];
     const double zeta = std::max(m.damping_ratio, 1e-4), f = m.frequency_hz, o = overlap[k] / kOverlapScale;
-    m.frequency_std_hz = f * std::sqrt(zeta / (M_PI * f * T)) * std::sqrt(1 + o * o);
+    m.frequency_std_hz = std::hypot(f * std::sqrt(zeta / (M_PI * f * T)) * std::sqrt(1 + o * o), kOrderShare * m.order_frequency_std_hz);
     m.damping_std = zeta * std::sqrt(1.0 / (M_PI * zeta * f * T));
   }
   s.stationary_record_s = T;
   s.notes.push_back(
       fmt("frequency and damping std from the stationary response (%.4g s of records): sigma_f / f = "
-          "sqrt(zeta / (pi f T)), widened where a neighbour overlaps; the split-data spread sets the shapes' std only",
-          T));
+          "sqrt(zeta / (pi f T)), widened where a neighbour overlaps, with %.2g of the spread over orders; the split-data "
+          "spread sets the shapes' std only",
+          T, kOrderShare));
 }
 
 // The two halves of the data: alternate records of every recording when each has two or more, else the two
