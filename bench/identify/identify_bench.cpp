@@ -290,7 +290,8 @@ Score score(const Case& c, const ModalData& truth, const std::vector<double>& sn
       double best = 1e9, bm = 0, bz = 0;  // best: the signed relative error of the nearest
       for (int q = 0; q < nr; ++q) {
         const double d = s.modes[static_cast<std::size_t>(q)].frequency_hz / truth.frequencies_hz[t] - 1;
-        if (std::abs(d) < std::abs(best)) best = d, bm = mac(q, t), bz = s.modes[static_cast<std::size_t>(q)].damping_ratio;
+        if (std::abs(d) < std::abs(best))
+          best = d, bm = mac(q, t), bz = s.modes[static_cast<std::size_t>(q)].damping_ratio;
       }
       // Why: outside the band analysed, or the nearest rejected cluster (within 2 %) and its reason.
       std::string why;
@@ -305,10 +306,10 @@ Score score(const Case& c, const ModalData& truth, const std::vector<double>& sn
       for (int q = 0; q < nt; ++q)
         if (q != t && std::abs(truth.frequencies_hz[q] / ft - 1) < std::abs(pair))
           pair = truth.frequencies_hz[q] / ft - 1;
-      sc.missed.push_back(
-          fmt::format("{:.4g} Hz (snr {:.0f} dB; nearest {:+.2f} %, MAC {:.2f}, zeta {:.2f} % vs {:.2f} %; next truth {:+.1f} %{})", ft,
-                      10 * std::log10(snr[static_cast<std::size_t>(t)]), nr ? 100 * best : 0.0, bm, 100 * bz,
-                      100 * truth.damping_ratios[t], 100 * pair, why));
+      sc.missed.push_back(fmt::format(
+          "{:.4g} Hz (snr {:.0f} dB; nearest {:+.2f} %, MAC {:.2f}, zeta {:.2f} % vs {:.2f} %; next truth {:+.1f} %{})",
+          ft, 10 * std::log10(snr[static_cast<std::size_t>(t)]), nr ? 100 * best : 0.0, bm, 100 * bz,
+          100 * truth.damping_ratios[t], 100 * pair, why));
     }
   }
   const auto [true_r, true_t] = match(0.02, 0.8, false);

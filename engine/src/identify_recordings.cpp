@@ -100,13 +100,17 @@ void split_uncertainty(IdentificationSummary& s, const IdentificationSummary& A,
   for (std::size_t k = 0; k < n; ++k) {
     IdentifiedMode& m = s.modes[k];
     const double zeta = std::max(m.damping_ratio, 1e-4);
-    m.frequency_std_hz = std::hypot(m.frequency_hz * zeta * std::max(ef[k], pool_f), kOrderShare * m.order_frequency_std_hz);
+    m.frequency_std_hz =
+        std::hypot(m.frequency_hz * zeta * std::max(ef[k], pool_f), kOrderShare * m.order_frequency_std_hz);
     m.damping_std = zeta * std::max(ez[k], pool_z);
     m.shape_std = std::max(es[k], pool_s);
     own += ef[k] >= 0;
   }
-  s.notes.push_back(fmt("split-data uncertainty: %.0f of %.0f modes found in both halves of the data; ", own, static_cast<double>(n)) +
-                    fmt("pooled sigma_f = %.3g x f zeta (with %.2g of the spread over orders), shape std %.3g of the largest entry", pool_f, kOrderShare, pool_s));
+  s.notes.push_back(
+      fmt("split-data uncertainty: %.0f of %.0f modes found in both halves of the data; ", own,
+          static_cast<double>(n)) +
+      fmt("pooled sigma_f = %.3g x f zeta (with %.2g of the spread over orders), shape std %.3g of the largest entry",
+          pool_f, kOrderShare, pool_s));
 }
 
 // The overlap of each mode with its nearest neighbour among the identified modes: their mean half-power
@@ -136,15 +140,16 @@ void stationary_response_uncertainty(IdentificationSummary& s, const std::vector
   for (std::size_t k = 0; k < s.modes.size(); ++k) {
     IdentifiedMode& m = s.modes[k];
     const double zeta = std::max(m.damping_ratio, 1e-4), f = m.frequency_hz, o = overlap[k] / kOverlapScale;
-    m.frequency_std_hz = std::hypot(f * std::sqrt(zeta / (M_PI * f * T)) * std::sqrt(1 + o * o), kOrderShare * m.order_frequency_std_hz);
+    m.frequency_std_hz =
+        std::hypot(f * std::sqrt(zeta / (M_PI * f * T)) * std::sqrt(1 + o * o), kOrderShare * m.order_frequency_std_hz);
     m.damping_std = zeta * std::sqrt(1.0 / (M_PI * zeta * f * T));
   }
   s.stationary_record_s = T;
-  s.notes.push_back(
-      fmt("frequency and damping std from the stationary response (%.4g s of records): sigma_f / f = "
-          "sqrt(zeta / (pi f T)), widened where a neighbour overlaps, with %.2g of the spread over orders; the split-data "
-          "spread sets the shapes' std only",
-          T, kOrderShare));
+  s.notes.push_back(fmt(
+      "frequency and damping std from the stationary response (%.4g s of records): sigma_f / f = "
+      "sqrt(zeta / (pi f T)), widened where a neighbour overlaps, with %.2g of the spread over orders; the split-data "
+      "spread sets the shapes' std only",
+      T, kOrderShare));
 }
 
 // The two halves of the data: alternate records of every recording when each has two or more, else the two
