@@ -695,74 +695,14 @@ Eigen::VectorXcd ssi_cluster_shape(const internal::OrderPoles& op, const interna
   return sum;
 }
 
-}  // namespace
-
-IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationOptions& o) {
-  const auto t0 = checked_start(o, frf_in, "LSCF: ");
-  const LscfInput in = lscf_input(frf_in, o);
-  const double decay = in.frf.window_decay;
-  IdentificationSummary s;
-  s.method = "lscf";
-  for (const Channel& c : in.frf.outputs) s.dofs.push_back(c.dof);
-  s.min_order = in.pmin;
-  s.max_order = in.pmax;
-  s.window_decay_removed = decay;
-  s.band_lo_hz = in.lo;
-  s.band_hi_hz = in.hi;
-  const Eigen::Index nl = frf_in.frequency_hz.size();
-  s.resolution_hz = nl > 1 ? (frf_in.frequency_hz[nl - 1] - frf_in.frequency_hz[0]) / static_cast<double>(nl - 1) : 0;
-  s.frequency_hz = frf_in.frequency_hz;
-  s.background = cmif(frf_in);
-  s.background_label = "CMIF (first singular value of the FRFs)";
-
-  const internal::OrderPoles poles = lscf_poles(in, lscf_normal_equations(in), decay);
-  // Selection on the CMIF's power (the windowed data's peaks are wider by the window's decay), then LSFD at the
-  // selected poles for the shapes.
-  internal::select_modes(
-      poles, in.lo, in.hi, o, s.background.cwiseAbs2(), decay,
-      [&](const std::vector<internal::PoleCluster>& all, std::size_t c) {
-        return lscf_cluster_shape(in, all, c, decay, s.resolution_hz, internal::kShapedShare * o.min_cluster_fraction,
-                                  o.min_mpc);
-      },
-      [&](const Eigen::VectorXcd& u) { return projected_frf_power(frf_in, u); }, s);
-  lscf_final_modes(in, frf_in, decay, o, s);
-  s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  return s;
-}
-
-namespace {
-
-// SSI-cov over one band (the options' band; decimation and block rows from it).
-IdentificationSummary identify_ssi_band(const Recording& rec, const IdentificationOptions& o) {
-  const SsiSetup u = ssi_setup(rec, o);
-  IdentificationSummary s;
-  s.method = "ssi";
-  for (int c : u.outs) s.dofs.push_back(rec.channels[c].dof);
-  s.min_order = u.nmin;
-  s.max_order = u.nmax;
-  s.band_lo_hz = u.lo;
-  s.band_hi_hz = u.hi;
-  const std::vector<Eigen::MatrixXd> records = ssi_records(rec, u);
-  const internal::OrderPoles poles = ssi_poles(ssi_toeplitz(records, u), u);
-  const CrossSpectra G = output_spectrum_indicator(records, u, o, s);
-  internal::select_modes(
-      poles, u.lo, u.hi, o, s.background, 0.0,
-      [&](const std::vector<internal::PoleCluster>& all, std::size_t c) {
-        return internal::ClusterShape{ssi_cluster_shape(poles, all[c]), -1.0};
-      },
-      [&](const Eigen::VectorXcd& shape) { return projected_spectrum(G, shape); }, s);
-  for (IdentifiedMode& m : s.modes) finish_shape(m);
-  return s;
-}
-
-// Sub-bands of a wide band (identify.hpp, identify_ssi): from the top down, each [hi / kSubBandSpan, hi], owning
-// [hi / 8, hi / 2] (the top one everything above hi / 8, the lowest everything below), the next one's top a
+// Sub-bands of a wide band (identify.hpp, identify_lscf / identify_ssi): from the top down, each [hi / kSubBandSpan,
+// hi], owning [hi / 8, hi / 2] (the top one everything above hi / 8, the lowest everything below), the next one's top a
 // quarter of this one's; the lowest reaches down to `flow`.
 constexpr double kSubBandSpan = 16;
 struct SubBand {
   double lo = 0, hi = 0, own_lo = 0, own_hi = 0;
 };
-std::vector<SubBand> ssi_sub_bands(double flow, double hi) {
+std::vector<SubBand> sub_bands(double flow, double hi) {
   std::vector<SubBand> out;
   if (hi / flow <= kSubBandSpan) return {{flow, hi, 0, 1e300}};
   for (double top = hi;; top /= 4) {
@@ -798,13 +738,130 @@ void merge_sub_band(IdentificationSummary& s, const IdentificationSummary& t, do
     }
 }
 
+// The merged modes in ascending frequency (the rejected splits' and the diagram poles' mode indices renumbered),
+// the rejected clusters too, and a note of the sub-bands.
+void sort_merged(IdentificationSummary& s, std::size_t bands, double flow, double hi, const char* label,
+                 const char* how) {
+  auto by_f = [](const auto& x, const auto& y) { return x.frequency_hz < y.frequency_hz; };
+  std::vector<std::size_t> order(s.modes.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t x, std::size_t y) { return by_f(s.modes[x], s.modes[y]); });
+  std::vector<int> rank(order.size());
+  std::vector<IdentifiedMode> modes;
+  for (std::size_t k = 0; k < order.size(); ++k)
+    rank[order[k]] = static_cast<int>(k), modes.push_back(s.modes[order[k]]);
+  s.modes = std::move(modes);
+  for (RejectedCluster& r : s.rejected)
+    if (r.merged_into >= 0) r.merged_into = rank[static_cast<std::size_t>(r.merged_into)];
+  for (StabilizationPole& p : s.poles)
+    if (p.cluster >= 0) p.cluster = rank[static_cast<std::size_t>(p.cluster)];
+  std::stable_sort(s.rejected.begin(), s.rejected.end(), by_f);
+  char b[200];
+  std::snprintf(b, sizeof b, "%s in %zu sub-bands (each 1:%g%s): the band %.4g-%.4g Hz spans 1:%.0f", label, bands,
+                kSubBandSpan, how, flow, hi, hi / flow);
+  s.notes.push_back(b);
+}
+
+// The summary's fields for LSCF over in's band (the CMIF of all the data as background).
+IdentificationSummary lscf_head(const FrfData& frf_in, const LscfInput& in) {
+  IdentificationSummary s;
+  s.method = "lscf";
+  for (const Channel& c : in.frf.outputs) s.dofs.push_back(c.dof);
+  s.min_order = in.pmin;
+  s.max_order = in.pmax;
+  s.window_decay_removed = in.frf.window_decay;
+  s.band_lo_hz = in.lo;
+  s.band_hi_hz = in.hi;
+  const Eigen::Index nl = frf_in.frequency_hz.size();
+  s.resolution_hz = nl > 1 ? (frf_in.frequency_hz[nl - 1] - frf_in.frequency_hz[0]) / static_cast<double>(nl - 1) : 0;
+  s.frequency_hz = frf_in.frequency_hz;
+  s.background = cmif(frf_in);
+  s.background_label = "CMIF (first singular value of the FRFs)";
+  return s;
+}
+
+// The poles of in's band and their selection on the CMIF's power (the windowed data's peaks are wider by the
+// window's decay); the modes' shapes are the clusters' until lscf_final_modes.
+void lscf_select(const FrfData& frf_in, const LscfInput& in, const IdentificationOptions& o, IdentificationSummary& s) {
+  const double decay = in.frf.window_decay;
+  const internal::OrderPoles poles = lscf_poles(in, lscf_normal_equations(in), decay);
+  internal::select_modes(
+      poles, in.lo, in.hi, o, s.background.cwiseAbs2(), decay,
+      [&](const std::vector<internal::PoleCluster>& all, std::size_t c) {
+        return lscf_cluster_shape(in, all, c, decay, s.resolution_hz, internal::kShapedShare * o.min_cluster_fraction,
+                                  o.min_mpc);
+      },
+      [&](const Eigen::VectorXcd& u) { return projected_frf_power(frf_in, u); }, s);
+}
+
+}  // namespace
+
+IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationOptions& o) {
+  const auto t0 = checked_start(o, frf_in, "LSCF: ");
+  const LscfInput in = lscf_input(frf_in, o);
+  IdentificationSummary s = lscf_head(frf_in, in);
+  // A wide band with automatic orders: poles and selection per sub-band (the lowest modes of a wide band need
+  // orders the strongest ones take), every sub-band giving the modes it owns; then LSFD over the whole band at
+  // all of them. A sub-band too narrow for its orders (too few lines) leaves the whole band to one fit.
+  const std::vector<SubBand> bands =
+      o.max_order == 0 && in.lo > 0 ? sub_bands(in.lo, in.hi) : std::vector<SubBand>{{in.lo, in.hi, 0, 1e300}};
+  bool whole = bands.size() == 1;
+  if (!whole) {
+    try {
+      for (const SubBand& b : bands) {
+        IdentificationOptions ob = o;
+        ob.band_lo_hz = b.lo;
+        ob.band_hi_hz = b.hi;
+        const LscfInput ib = lscf_input(frf_in, ob);
+        IdentificationSummary t = lscf_head(frf_in, ib);
+        lscf_select(frf_in, ib, ob, t);
+        merge_sub_band(s, t, b.own_lo, b.own_hi);
+      }
+      sort_merged(s, bands.size(), in.lo, in.hi, "LSCF", "");
+    } catch (const InputError&) {
+      s = lscf_head(frf_in, in);
+      whole = true;
+    }
+  }
+  if (whole) lscf_select(frf_in, in, o, s);
+  lscf_final_modes(in, frf_in, in.frf.window_decay, o, s);
+  s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return s;
+}
+
+namespace {
+
+// SSI-cov over one band (the options' band; decimation and block rows from it).
+IdentificationSummary identify_ssi_band(const Recording& rec, const IdentificationOptions& o) {
+  const SsiSetup u = ssi_setup(rec, o);
+  IdentificationSummary s;
+  s.method = "ssi";
+  for (int c : u.outs) s.dofs.push_back(rec.channels[c].dof);
+  s.min_order = u.nmin;
+  s.max_order = u.nmax;
+  s.band_lo_hz = u.lo;
+  s.band_hi_hz = u.hi;
+  const std::vector<Eigen::MatrixXd> records = ssi_records(rec, u);
+  const internal::OrderPoles poles = ssi_poles(ssi_toeplitz(records, u), u);
+  const CrossSpectra G = output_spectrum_indicator(records, u, o, s);
+  internal::select_modes(
+      poles, u.lo, u.hi, o, s.background, 0.0,
+      [&](const std::vector<internal::PoleCluster>& all, std::size_t c) {
+        return internal::ClusterShape{ssi_cluster_shape(poles, all[c]), -1.0};
+      },
+      [&](const Eigen::VectorXcd& shape) { return projected_spectrum(G, shape); }, s);
+  for (IdentifiedMode& m : s.modes) finish_shape(m);
+  return s;
+}
+
 }  // namespace
 
 IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOptions& o) {
   const auto t0 = checked_start(o, rec, "SSI: ");
   const SsiSetup u = ssi_setup(rec, o);
   const std::vector<SubBand> bands =
-      o.decimate == 0 && o.block_rows == 0 ? ssi_sub_bands(u.flow, u.hi) : std::vector<SubBand>{{u.lo, u.hi, 0, 1e300}};
+      o.decimate == 0 && o.block_rows == 0 ? sub_bands(u.flow, u.hi) : std::vector<SubBand>{{u.lo, u.hi, 0, 1e300}};
   IdentificationSummary s;
   if (bands.size() == 1) {
     s = identify_ssi_band(rec, o);
@@ -822,26 +879,7 @@ IdentificationSummary identify_ssi(const Recording& rec, const IdentificationOpt
       }
       merge_sub_band(s, t, bands[k].own_lo, bands[k].own_hi);
     }
-    auto by_f = [](const auto& x, const auto& y) { return x.frequency_hz < y.frequency_hz; };
-    std::vector<std::size_t> order(s.modes.size());
-    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-    std::stable_sort(order.begin(), order.end(),
-                     [&](std::size_t x, std::size_t y) { return by_f(s.modes[x], s.modes[y]); });
-    std::vector<int> rank(order.size());
-    std::vector<IdentifiedMode> modes;
-    for (std::size_t k = 0; k < order.size(); ++k)
-      rank[order[k]] = static_cast<int>(k), modes.push_back(s.modes[order[k]]);
-    s.modes = std::move(modes);
-    for (RejectedCluster& r : s.rejected)
-      if (r.merged_into >= 0) r.merged_into = rank[static_cast<std::size_t>(r.merged_into)];
-    for (StabilizationPole& p : s.poles)
-      if (p.cluster >= 0) p.cluster = rank[static_cast<std::size_t>(p.cluster)];
-    std::stable_sort(s.rejected.begin(), s.rejected.end(), by_f);
-    char b[200];
-    std::snprintf(b, sizeof b,
-                  "SSI in %zu sub-bands (each 1:%g, decimated to its top): the band %.4g-%.4g Hz spans 1:%.0f",
-                  bands.size(), kSubBandSpan, u.flow, u.hi, u.hi / u.flow);
-    s.notes.push_back(b);
+    sort_merged(s, bands.size(), u.flow, u.hi, "SSI", ", decimated to its top");
   }
   mark_twins(s.modes, false);
   s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
