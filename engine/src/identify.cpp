@@ -763,8 +763,9 @@ void sort_merged(IdentificationSummary& s, std::size_t bands, double flow, doubl
   s.notes.push_back(b);
 }
 
-// The summary's fields for LSCF over in's band (the CMIF of all the data as background).
-IdentificationSummary lscf_head(const FrfData& frf_in, const LscfInput& in) {
+// The summary's fields for LSCF over in's band; `background` is the CMIF of all the data (cmif(frf_in)), computed
+// once for the whole band and its sub-bands.
+IdentificationSummary lscf_head(const FrfData& frf_in, const LscfInput& in, const Eigen::VectorXd& background) {
   IdentificationSummary s;
   s.method = "lscf";
   for (const Channel& c : in.frf.outputs) s.dofs.push_back(c.dof);
@@ -776,7 +777,7 @@ IdentificationSummary lscf_head(const FrfData& frf_in, const LscfInput& in) {
   const Eigen::Index nl = frf_in.frequency_hz.size();
   s.resolution_hz = nl > 1 ? (frf_in.frequency_hz[nl - 1] - frf_in.frequency_hz[0]) / static_cast<double>(nl - 1) : 0;
   s.frequency_hz = frf_in.frequency_hz;
-  s.background = cmif(frf_in);
+  s.background = background;
   s.background_label = "CMIF (first singular value of the FRFs)";
   return s;
 }
@@ -800,7 +801,8 @@ void lscf_select(const FrfData& frf_in, const LscfInput& in, const Identificatio
 IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationOptions& o) {
   const auto t0 = checked_start(o, frf_in, "LSCF: ");
   const LscfInput in = lscf_input(frf_in, o);
-  IdentificationSummary s = lscf_head(frf_in, in);
+  const Eigen::VectorXd background = cmif(frf_in);
+  IdentificationSummary s = lscf_head(frf_in, in, background);
   // A wide band with automatic orders: poles and selection per sub-band (the lowest modes of a wide band need
   // orders the strongest ones take), every sub-band giving the modes it owns; then LSFD over the whole band at
   // all of them. A sub-band too narrow for its orders (too few lines) leaves the whole band to one fit.
@@ -814,13 +816,13 @@ IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationO
         ob.band_lo_hz = b.lo;
         ob.band_hi_hz = b.hi;
         const LscfInput ib = lscf_input(frf_in, ob);
-        IdentificationSummary t = lscf_head(frf_in, ib);
+        IdentificationSummary t = lscf_head(frf_in, ib, background);
         lscf_select(frf_in, ib, ob, t);
         merge_sub_band(s, t, b.own_lo, b.own_hi);
       }
       sort_merged(s, bands.size(), in.lo, in.hi, "LSCF", "");
     } catch (const InputError&) {
-      s = lscf_head(frf_in, in);
+      s = lscf_head(frf_in, in, background);
       whole = true;
     }
   }
