@@ -796,10 +796,53 @@ void lscf_select(const FrfData& frf_in, const LscfInput& in, const Identificatio
       [&](const Eigen::VectorXcd& u) { return projected_frf_power(frf_in, u); }, s);
 }
 
+// The FRFs without the references that excite nothing: an input whose FRF power is below kDeadPower of the
+// strongest input's (-120 dB, beyond any acquisition's dynamic range) carries no information, and its numerically zero
+// columns leave LSCF's poly-reference normal equations rank-deficient (the denominator's block for that input
+// undetermined, no pole stable over the orders). One note per reference left out. (An output channel that sees nothing
+// keeps its unit-RMS weight: on the identification benchmark's dev seeds, weighting such channels 0 changed one
+// marginal mode, found -> missed.)
+constexpr double kDeadPower = 1e-12;
+
+FrfData live_references(const FrfData& frf, std::vector<std::string>& notes) {
+  const int ni = frf.num_inputs(), no = frf.num_outputs();
+  Eigen::VectorXd power(ni);
+  for (int i = 0; i < ni; ++i) power[i] = frf.H.middleCols(i * no, no).squaredNorm();
+  const double top = ni > 0 ? power.maxCoeff() : 0;
+  std::vector<int> keep;
+  for (int i = 0; i < ni; ++i) {
+    if (!(top > 0) || power[i] >= kDeadPower * top) {
+      keep.push_back(i);
+      continue;
+    }
+    char b[240];
+    std::snprintf(b, sizeof b,
+                  "reference %s left out: its FRFs are %.0f dB below the strongest reference's (it excites nothing "
+                  "the sensors record, e.g. a hit on a support)",
+                  to_string(frf.inputs[static_cast<std::size_t>(i)].dof).c_str(),
+                  power[i] > 0 ? 10 * std::log10(top / power[i]) : 300.0);
+    notes.push_back(b);
+  }
+  if (static_cast<int>(keep.size()) == ni) return frf;
+  FrfData live = frf;
+  live.inputs.clear();
+  live.H.resize(frf.H.rows(), no * static_cast<Eigen::Index>(keep.size()));
+  if (frf.coherence.size() > 0) live.coherence.resize(frf.coherence.rows(), live.H.cols());
+  for (std::size_t j = 0; j < keep.size(); ++j) {
+    const Eigen::Index from = keep[j] * no, to = static_cast<Eigen::Index>(j) * no;
+    live.inputs.push_back(frf.inputs[static_cast<std::size_t>(keep[j])]);
+    live.H.middleCols(to, no) = frf.H.middleCols(from, no);
+    if (frf.coherence.size() > 0) live.coherence.middleCols(to, no) = frf.coherence.middleCols(from, no);
+  }
+  return live;
+}
+
 }  // namespace
 
-IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationOptions& o) {
-  const auto t0 = checked_start(o, frf_in, "LSCF: ");
+IdentificationSummary identify_lscf(const FrfData& frf_all, const IdentificationOptions& o) {
+  const auto t0 = checked_start(o, frf_all, "LSCF: ");
+  std::vector<std::string> dropped;
+  const FrfData frf_in = live_references(frf_all, dropped);
   const LscfInput in = lscf_input(frf_in, o);
   const Eigen::VectorXd background = cmif(frf_in);
   IdentificationSummary s = lscf_head(frf_in, in, background);
@@ -828,6 +871,7 @@ IdentificationSummary identify_lscf(const FrfData& frf_in, const IdentificationO
   }
   if (whole) lscf_select(frf_in, in, o, s);
   lscf_final_modes(in, frf_in, in.frf.window_decay, o, s);
+  s.notes.insert(s.notes.begin(), dropped.begin(), dropped.end());
   s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return s;
 }

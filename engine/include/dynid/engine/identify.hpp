@@ -233,7 +233,9 @@ IdentificationPlan plan_identification(const FrfData& frf, const IdentificationO
 /// lowest modes of a wide band otherwise appear only at the orders the strongest modes leave them (on the
 /// discovery benchmark's dev impact tests, 71: named right 44 -> 47, within 10 % 37 -> 41, nulls 7 -> 8 of 8;
 /// the identification benchmark's dev seeds 0-59 unchanged, found 231 of 266). A sub-band with too few lines
-/// for its orders leaves the whole band to one fit.
+/// for its orders leaves the whole band to one fit. A reference whose FRFs are 120 dB below the strongest
+/// reference's (it excites nothing the sensors record) is left out with a note: its numerically zero columns
+/// would leave the poly-reference fit rank-deficient.
 IdentificationSummary identify_lscf(const FrfData& frf, const IdentificationOptions& options);
 
 /// SSI-cov on the output channels of a recording (all outputs are references; records are concatenated into
