@@ -1,6 +1,7 @@
 // dynid_identify_bench: modal identification on randomized virtual tests, scored against the truth.
 //
-//   dynid_identify_bench [--split dev|test] [--count N] [--from K] [--out DIR] [--verbose] [--one-layout]
+//   dynid_identify_bench [--split dev|test] [--count N] [--from K] [--out DIR] [--verbose] [--one-layout] [--keep]
+//   (--keep: the UFF files of every test stay in DIR/t<k>/ for dynid identify)
 //
 // Each test (seed) draws a structure (a beam with cantilever, simply supported or clamped ends; a plane frame; a
 // 3D frame whose columns are slightly stiffer about one axis, so its x and y sway modes come in closely spaced
@@ -401,7 +402,7 @@ std::string row(const std::string& name, const Tally& t) {
 int main(int argc, char** argv) {
   std::string split = "test", out = "";
   int count = 200, from = 0;
-  bool verbose = false, one_layout = false;
+  bool verbose = false, one_layout = false, keep = false;
   for (int a = 1; a < argc; ++a) {
     const std::string s = argv[a];
     auto next = [&]() -> std::string {
@@ -414,8 +415,11 @@ int main(int argc, char** argv) {
     else if (s == "--out") out = next();
     else if (s == "--verbose") verbose = true;
     else if (s == "--one-layout") one_layout = true;
+    else if (s == "--keep") keep = true;
     else {
-      fmt::print(stderr, "usage: dynid_identify_bench [--split dev|test] [--count N] [--from K] [--out DIR] [--verbose] [--one-layout]\n");
+      fmt::print(stderr,
+                 "usage: dynid_identify_bench [--split dev|test] [--count N] [--from K] [--out DIR] [--verbose] "
+                 "[--one-layout] [--keep]\n");
       return 2;
     }
   }
@@ -478,7 +482,7 @@ int main(int argc, char** argv) {
         by_key["structure " + c.structure].add(sc[layout]);
       }
     }
-    fs::remove_all(tdir);
+    if (!keep) fs::remove_all(tdir);
     if (!one_layout) {
       ++compared;
       equal_layouts += same_recordings(read[0], read[1]);
@@ -495,7 +499,7 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
     }
   }
-  fs::remove_all(dir);
+  if (!keep) fs::remove_all(dir);
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   fmt::print("\n{} seeds {}..{} ({} tests), {:.0f} s\n\n", split, base + static_cast<std::uint64_t>(from), base + static_cast<std::uint64_t>(from + count - 1), count, total);
   fmt::print("| set | tests | in-band modes | found | reported | spurious | median damping error | identification time |\n");
