@@ -417,7 +417,8 @@ int main(int argc, char** argv) {
     else if (s == "--out") out = next();
     else if (s == "--verbose") verbose = true;
     else if (s == "--one-layout") one_layout = true;
-    else if (s == "--keep") keep = true;
+    else if (s == "--keep")
+      keep = true;
     else {
       fmt::print(stderr,
                  "usage: dynid_identify_bench [--split dev|test] [--count N] [--from K] [--out DIR] [--verbose] "
