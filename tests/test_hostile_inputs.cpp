@@ -3,6 +3,7 @@
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <chrono>
 #include <filesystem>
@@ -11,6 +12,7 @@
 #include <thread>
 
 #include "dynid/io/case_file.hpp"
+#include "dynid/io/mat_file.hpp"
 #include "dynid/io/matrix_market.hpp"
 #include "dynid/io/mesh_files.hpp"
 #include "dynid/io/modal_data_io.hpp"
@@ -121,6 +123,30 @@ TEST(HostileInputs, UffOrdinateTypeOutOfIntRange) {
       ErrorOf([] { parse_uff(Hostile("uff58b-type-out-of-range.uff"), "uff58b-type-out-of-range.uff"); });
   EXPECT_HAS(e, "uff58b-type-out-of-range.uff");
   EXPECT_HAS(e, "ordinate data type must be 2 (real single), 4 (real double), 5 (complex single) or 6 (complex double)");
+}
+
+TEST(HostileInputs, MatSparseTagLargerThanItsArray) {
+  // fuzz_mat: a 364-byte v5 file whose sparse K declares 4294905868 bytes of column pointers; libmatio allocated
+  // them before reading (4 GB; 26 s under ASan). Refused before libmatio reads the variable, stored as is and
+  // inside a zlib stream (miCOMPRESSED: the same array element, deflated).
+  const std::string seed = test::CasesDir() + "/../fuzz/corpus/fuzz_mat/damaged-sparse-4gb.mat";
+  const std::string bytes = Slurp(seed);
+  ASSERT_EQ(bytes.size(), 364u);
+  const std::string want =
+      "variable 'K': its sparse column pointers (jc) declare 4294905868 bytes where the array holds 56";
+  EXPECT_HAS(ErrorOf([&] { MatFile(seed).sparse("K", "stiffness"); }), want);
+  const std::string element = bytes.substr(128, 8 + 128);  // the miMATRIX element of K (tag + 128 bytes)
+  std::vector<unsigned char> packed(compressBound(element.size()));
+  uLongf n = packed.size();
+  ASSERT_EQ(compress(packed.data(), &n, reinterpret_cast<const Bytef*>(element.data()), element.size()), Z_OK);
+  std::string file = bytes.substr(0, 128);
+  const std::uint32_t tag[2] = {15, static_cast<std::uint32_t>(n)};  // miCOMPRESSED, little-endian as the header says
+  file.append(reinterpret_cast<const char*>(tag), 8);
+  file.append(reinterpret_cast<const char*>(packed.data()), n);
+  const test::ScratchDir dir("mat-sparse");
+  const std::string z = dir.path("compressed.mat");
+  std::ofstream(z, std::ios::binary) << file;
+  EXPECT_HAS(ErrorOf([&] { MatFile(z).sparse("K", "stiffness"); }), want);
 }
 
 namespace fs = std::filesystem;

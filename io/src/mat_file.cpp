@@ -15,6 +15,7 @@
 #include "dynid/io/limits.hpp"
 #include "dynid/io/modal_data_io.hpp"
 #include "dynid/mesh/error.hpp"
+#include "internal/mat_v5_check.hpp"
 #include "internal/text_util.hpp"
 
 namespace dynid {
@@ -135,7 +136,12 @@ struct MatFile::Handle {
                " elements)");
     // A damaged header can declare far more data than the file holds, and libmatio allocates what it declares
     // before reading (fuzz_mat found a 4 GB request from a 1 kB file). Data never exceeds the file by more than
-    // zlib's largest ratio (about 1032:1); sparse arrays hold fewer values than their dimensions.
+    // zlib's largest ratio (about 1032:1); sparse arrays hold fewer values than their dimensions, and their v5
+    // tags are checked against the array that holds them (internal/mat_v5_check.hpp).
+    if (info->class_type == MAT_C_SPARSE && Mat_GetVersion(mat) == MAT_FT_MAT5) {
+      const std::string why = internal::v5_sparse_damage(path, name);
+      if (!why.empty()) fail(path, name, why + ": the file is damaged; save it again from MATLAB or SciPy");
+    }
     if (info->class_type != MAT_C_SPARSE) {
       std::error_code ec;
       const double file_bytes = static_cast<double>(std::filesystem::file_size(path, ec));

@@ -69,13 +69,15 @@ def savemat73(path, variables):
 
 
 def savemat(path, variables, version):
-    if version == "v5":
+    """version: "v5" (as SciPy writes by default), "v5z" (v5 with each variable deflated: MATLAB's -v7) or "v7.3"."""
+    if version in ("v5", "v5z"):
         def cell(v):  # a list is a cell array (n x 1), an object array for SciPy
             a = np.empty((len(v), 1), dtype=object)
             for k, x in enumerate(v):
                 a[k, 0] = x
             return a
-        scipy.io.savemat(path, {k: (cell(v) if isinstance(v, list) else v) for k, v in variables.items()}, format="5")
+        scipy.io.savemat(path, {k: (cell(v) if isinstance(v, list) else v) for k, v in variables.items()}, format="5",
+                         do_compression=version == "v5z")
     else:
         savemat73(path, variables)
 
@@ -104,7 +106,7 @@ def frame_mats(paper_frame):
     return K, M, groups, dofs, nodes
 
 
-@pytest.mark.parametrize("version", ["v5", "v7.3"])
+@pytest.mark.parametrize("version", ["v5", "v5z", "v7.3"])
 @pytest.mark.parametrize("storage", ["sparse", "dense"])
 def test_matrix_model_from_mat(tmp_path, paper_frame, frame_mats, version, storage):
     K, M, groups, dofs, nodes = frame_mats
