@@ -9,11 +9,12 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
-#include <vector>
+#include <string>
 
 namespace dynid::internal {
 
