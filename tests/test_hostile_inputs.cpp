@@ -149,6 +149,46 @@ TEST(HostileInputs, MatSparseTagLargerThanItsArray) {
   EXPECT_HAS(ErrorOf([&] { MatFile(z).sparse("K", "stiffness"); }), want);
 }
 
+TEST(HostileInputs, MatDamagedHeaderWhileListing) {
+  // fuzz_mat (CI, 2026-11-28): a 497-byte v5 file whose double array declares 1633943556 bytes of dimensions;
+  // libmatio's Mat_VarReadNextInfo allocated them while dynid listed the variables for an error message (26.6 s
+  // under ASan). Every variable's tags are now checked when the file is opened.
+  const std::string seed = test::CasesDir() + "/../fuzz/corpus/fuzz_mat/damaged-dims-listing.mat";
+  EXPECT_HAS(ErrorOf([&] { MatFile{seed}; }), "the variable at byte 128: its dimensions declare 1633943556 bytes where the array holds 337: the file is damaged");
+}
+
+// A v5 file (little-endian) holding the cell array c = {[1 2]}; `data_bytes` is what the double's data tag declares
+// (16 when intact).
+std::string CellFile(std::uint32_t data_bytes) {
+  std::string f = "MATLAB 5.0 MAT-file, written by dynid's tests";
+  f.resize(124, ' ');
+  f += std::string("\x00\x01IM", 4);
+  auto put = [&](std::initializer_list<std::uint32_t> words) {
+    for (std::uint32_t w : words) f.append(reinterpret_cast<const char*>(&w), 4);
+  };
+  // miMATRIX (14): flags (miUINT32 6, class 1 = cell), dims (miINT32 5: 1 x 1), name "c" (small miINT8 1), then
+  // one cell: miMATRIX with flags (class 6 = double), dims 1 x 2, an empty name, and two doubles (miDOUBLE 9).
+  put({14, 112, 6, 8, 1, 0, 5, 8, 1, 1, 0x00010001, 'c'});
+  put({14, 64, 6, 8, 6, 0, 5, 8, 1, 2, 1, 0, 9, data_bytes});
+  const double v[2] = {1.0, 2.0};
+  f.append(reinterpret_cast<const char*>(v), 16);
+  return f;
+}
+
+TEST(HostileInputs, MatDamagedTagInsideACell) {
+  const test::ScratchDir dir("mat-cell");
+  const std::string good = dir.path("good.mat"), bad = dir.path("bad.mat");
+  std::ofstream(good, std::ios::binary) << CellFile(16);
+  std::ofstream(bad, std::ios::binary) << CellFile(0x80000000u);
+  const std::vector<MatFile::Info> vars = MatFile(good).variables();  // the intact file opens and lists
+  ASSERT_EQ(vars.size(), 1u);
+  EXPECT_EQ(vars[0].name, "c");
+  EXPECT_EQ(vars[0].type, "cell");
+  EXPECT_HAS(ErrorOf([&] { MatFile{bad}; }),
+             "bad.mat: variable 'c' cell 1: its real data declare 2147483648 bytes where the array holds 16: the file "
+             "is damaged");
+}
+
 namespace fs = std::filesystem;
 
 // A fresh folder holding one earlier result, result.json ("earlier result\n"); removed afterwards.

@@ -136,12 +136,8 @@ struct MatFile::Handle {
                " elements)");
     // A damaged header can declare far more data than the file holds, and libmatio allocates what it declares
     // before reading (fuzz_mat found a 4 GB request from a 1 kB file). Data never exceeds the file by more than
-    // zlib's largest ratio (about 1032:1); sparse arrays hold fewer values than their dimensions, and their v5
-    // tags are checked against the array that holds them (internal/mat_v5_check.hpp).
-    if (info->class_type == MAT_C_SPARSE && Mat_GetVersion(mat) == MAT_FT_MAT5) {
-      const std::string why = internal::v5_sparse_damage(path, name);
-      if (!why.empty()) fail(path, name, why + ": the file is damaged; save it again from MATLAB or SciPy");
-    }
+    // zlib's largest ratio (about 1032:1); sparse arrays hold fewer values than their dimensions, and a v5 file's
+    // tags were checked against the arrays that hold them when it was opened (internal/mat_v5_check.hpp).
     if (info->class_type != MAT_C_SPARSE) {
       std::error_code ec;
       const double file_bytes = static_cast<double>(std::filesystem::file_size(path, ec));
@@ -169,6 +165,11 @@ MatFile::MatFile(const std::string& path, const ReaderLimits& limits)
   if (!h_->mat)
     throw InputError(path + ": not a MATLAB .mat file (v4, v5/v7 or v7.3)" + matio_says() +
                      "; save it from MATLAB with save(..., '-v7') or '-v7.3', or from Python with scipy.io.savemat");
+  // Before libmatio lists or reads anything: it sizes allocations by the v5 tags (internal/mat_v5_check.hpp).
+  if (Mat_GetVersion(h_->mat) == MAT_FT_MAT5) {
+    const std::string why = internal::v5_damage(path);
+    if (!why.empty()) throw InputError(path + ": " + why + ": the file is damaged; save it again from MATLAB or SciPy");
+  }
 }
 
 MatFile::~MatFile() = default;

@@ -1,10 +1,12 @@
-// The tags of a v5 sparse variable checked against the array that holds them (internal/mat_v5_check.hpp).
+// Every v5 variable's tags checked against the array that holds them (internal/mat_v5_check.hpp).
 //
 // v5 layout (MathWorks, "MAT-File Format"): a 128-byte header whose last two bytes tell the byte order, then data
 // elements, each an 8-byte tag (type, byte count) and its data padded to 8 bytes; a tag whose upper 16 bits are
 // not zero is a small element (count in the upper half, 4 data bytes inline). A variable is a miMATRIX element
-// (type 14), stored as is or inside a zlib stream (miCOMPRESSED, type 15); a sparse one holds array flags, dims,
-// name, then ir, jc and the real (and imaginary) values.
+// (type 14), stored as is or inside a zlib stream (miCOMPRESSED, type 15). An array holds its flags, dims and
+// name, then by class: the real (and imaginary) data of a numeric or char array; ir, jc and the values of a
+// sparse one; one miMATRIX element per cell of a cell array; the field name length, the field names and one
+// miMATRIX element per field of a struct (an object first names its class).
 #include "internal/mat_v5_check.hpp"
 
 #include <zlib.h>
@@ -21,7 +23,10 @@ namespace dynid::internal {
 namespace {
 
 constexpr std::uint32_t kMiMatrix = 14, kMiCompressed = 15;
-constexpr std::uint32_t kSparseClass = 5, kComplexFlag = 0x0800;
+constexpr std::uint32_t kComplexFlag = 0x0800;
+// Array classes (the low byte of the flags).
+constexpr std::uint32_t kCell = 1, kStruct = 2, kObject = 3, kChar = 4, kSparse = 5, kDouble = 6, kUint64 = 15;
+constexpr int kMaxDepth = 64;
 
 // Bytes in file order, from the file itself or from a variable's inflated zlib stream.
 class Source {
@@ -123,54 +128,136 @@ bool read_tag(Source& s, bool swap, Tag* t) {
   return true;
 }
 
-// Checks one miMATRIX element of `size` bytes (its tag read): "" unless it is the sparse variable `name` with a
-// sub-element declaring more than the array holds. *found is set when the variable is `name`.
-std::string check_matrix(Source& s, bool swap, std::uint64_t size, const std::string& name, bool* found) {
-  std::uint64_t left = size;
-  auto next = [&](Tag* t) {
-    if (left < 8 || !read_tag(s, swap, t)) return false;
-    left -= 8;
+// The walk of one array element: what is wrong with it ("" when every tag it reached fits). `end` is set when
+// the bytes ran out or the layout is one this walk does not know: the rest is left to libmatio's own checks.
+class ArrayWalk {
+ public:
+  ArrayWalk(Source& s, bool swap) : s_(s), swap_(swap) {}
+  // The miMATRIX element `who` of `size` bytes, its tag read; consumes all of them unless the walk ended. A
+  // top-level array (depth 0) is named by its variable name once that is read.
+  std::string array(std::uint64_t size, std::string who, int depth) {
+    if (depth > kMaxDepth)
+      return who + " is nested more than " + std::to_string(kMaxDepth) + " levels deep (dynid reads at most that)";
+    std::uint64_t left = size;
+    Tag flags, dims, name;
+    if (!next(&left, &flags) || flags.small || flags.bytes < 8) return stop();
+    if (over(flags, left)) return who + declares("array flags", flags.bytes, left);
+    unsigned char fb[8];
+    if (!s_.read(fb, 8) || !pass(&left, flags, 8)) return stop();
+    const std::uint32_t word = u32(fb, swap_);
+    if (!next(&left, &dims)) return stop();
+    if (over(dims, left)) return who + declares("dimensions", dims.bytes, left);
+    if (!pass(&left, dims, 0) || !next(&left, &name)) return stop();
+    if (over(name, left)) return who + declares("name", name.bytes, left);
+    std::string var;
+    if (name.small) {
+      var.assign(reinterpret_cast<const char*>(name.inline_data.data()), std::min<std::uint64_t>(name.bytes, 4));
+    } else {
+      var.resize(std::min<std::uint64_t>(name.bytes, 256));
+      if (!s_.read(var.data(), var.size()) || !pass(&left, name, var.size())) return stop();
+    }
+    if (depth == 0) who = "variable '" + var + "'";
+    const std::uint32_t cls = word & 0xFF;
+    const bool complex = word & kComplexFlag;
+    std::string why;
+    if (cls == kCell)
+      why = cells(&left, who, depth);
+    else if (cls == kStruct || cls == kObject)
+      why = fields(&left, who, depth, cls == kObject);
+    else if (cls == kSparse)
+      why = parts(&left, who, complex ? 4 : 3, true);
+    else if (cls == kChar || (cls >= kDouble && cls <= kUint64))
+      why = parts(&left, who, complex ? 2 : 1, false);
+    // else: function handles and opaque objects, which dynid does not read; libmatio checks them.
+    if (!why.empty() || end_ || depth == 0) return why;  // a top-level array need not be read to its end
+    if (!s_.skip(left)) return stop();
+    return "";
+  }
+
+ private:
+  // A tag declaring more data than the array holds (a small element's data is inside its tag).
+  static bool over(const Tag& t, std::uint64_t left) { return !t.small && t.bytes > left; }
+  bool next(std::uint64_t* left, Tag* t) {
+    if (*left < 8 || !read_tag(s_, swap_, t)) return false;
+    *left -= 8;
     return true;
-  };
-  Tag flags, dims, nm;
-  if (!next(&flags) || flags.small || flags.bytes < 8 || flags.stored > left) return "";
-  unsigned char fb[8];
-  if (!s.read(fb, 8) || !s.skip(flags.stored - 8)) return "";
-  left -= flags.stored;
-  const std::uint32_t word = u32(fb, swap);
-  if (!next(&dims) || dims.stored > left || !s.skip(dims.stored)) return "";
-  left -= dims.stored;
-  if (!next(&nm) || nm.stored > left) return "";
-  std::string var;
-  if (nm.small) {
-    var.assign(reinterpret_cast<const char*>(nm.inline_data.data()), std::min<std::uint64_t>(nm.bytes, 4));
-  } else {
-    if (nm.bytes > 4096) return "";
-    var.resize(nm.bytes);
-    if (!s.read(var.data(), nm.bytes) || !s.skip(nm.stored - nm.bytes)) return "";
-    left -= nm.stored;
   }
-  if (var != name) return "";
-  *found = true;
-  if ((word & 0xFF) != kSparseClass) return "";
-  const char* what[] = {"row indices (ir)", "column pointers (jc)", "values", "imaginary values"};
-  const int parts = (word & kComplexFlag) ? 4 : 3;
-  for (int k = 0; k < parts; ++k) {
+  // Past the data of `t` (and its padding, as far as the array holds it), `done` of its bytes already read.
+  bool pass(std::uint64_t* left, const Tag& t, std::uint64_t done) {
+    const std::uint64_t n = std::min(t.stored, *left);
+    if (n < done || !s_.skip(n - done)) return false;
+    *left -= n;
+    return true;
+  }
+  std::string stop() {
+    end_ = true;
+    return "";
+  }
+  static std::string declares(const std::string& what, std::uint64_t bytes, std::uint64_t holds) {
+    return ": its " + what + " declare " + std::to_string(bytes) + " bytes where the array holds " +
+           std::to_string(holds);
+  }
+  // `n` data elements in a row (a numeric or char array's real and imaginary data; a sparse array's ir, jc and
+  // values): each must fit. The last one's data is left to the caller (a top-level array is not read further).
+  std::string parts(std::uint64_t* left, const std::string& who, int n, bool sparse) {
+    static const char* const numeric_names[] = {"real data", "imaginary data"};
+    static const char* const sparse_names[] = {"sparse row indices (ir)", "sparse column pointers (jc)",
+                                               "sparse values", "sparse imaginary values"};
+    for (int k = 0; k < n; ++k) {
+      Tag t;
+      if (!next(left, &t)) return stop();
+      if (over(t, *left)) return who + declares(sparse ? sparse_names[k] : numeric_names[k], t.bytes, *left);
+      if (k + 1 < n && !pass(left, t, 0)) return stop();
+    }
+    return "";
+  }
+  std::string nested(std::uint64_t* left, const std::string& who, int depth) {
     Tag t;
-    if (!next(&t)) return "";
-    if (!t.small && t.bytes > left)
-      return std::string("its sparse ") + what[k] + " declare " + std::to_string(t.bytes) +
-             " bytes where the array holds " + std::to_string(left);
-    if (k + 1 == parts) break;
-    if (!s.skip(t.stored)) return "";
-    left -= t.stored;
+    if (!next(left, &t) || t.small || t.type != kMiMatrix) return stop();
+    if (over(t, *left))
+      return who + ": its array element declares " + std::to_string(t.bytes) + " bytes where the enclosing array holds " +
+             std::to_string(*left);
+    const std::uint64_t n = std::min(t.stored, *left);
+    const std::string why = array(n, who, depth + 1);
+    if (!why.empty() || end_) return why;
+    *left -= n;
+    return "";
   }
-  return "";
-}
+  std::string cells(std::uint64_t* left, const std::string& who, int depth) {
+    for (std::uint64_t k = 1; *left >= 8; ++k) {
+      const std::string why = nested(left, who + " cell " + std::to_string(k), depth);
+      if (!why.empty() || end_) return why;
+    }
+    return "";
+  }
+  std::string fields(std::uint64_t* left, const std::string& who, int depth, bool object) {
+    Tag t;
+    if (object) {
+      if (!next(left, &t)) return stop();
+      if (over(t, *left)) return who + declares("class name", t.bytes, *left);
+      if (!pass(left, t, 0)) return stop();
+    }
+    if (!next(left, &t) || !t.small || t.bytes != 4) return stop();
+    const std::uint32_t length = u32(t.inline_data.data(), swap_);
+    if (!next(left, &t)) return stop();
+    if (over(t, *left)) return who + declares("field names", t.bytes, *left);
+    if (!pass(left, t, 0)) return stop();
+    const std::uint64_t n = length ? t.bytes / length : 0;
+    for (std::uint64_t k = 1; k <= n && *left >= 8; ++k) {
+      const std::string why = nested(left, who + " field " + std::to_string(k), depth);
+      if (!why.empty() || end_) return why;
+    }
+    return "";
+  }
+
+  Source& s_;
+  bool swap_;
+  bool end_ = false;
+};
 
 }  // namespace
 
-std::string v5_sparse_damage(const std::string& path, const std::string& name) {
+std::string v5_damage(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   unsigned char header[128];
   if (!in.read(reinterpret_cast<char*>(header), 128)) return "";
@@ -191,19 +278,19 @@ std::string v5_sparse_damage(const std::string& path, const std::string& name) {
     Tag t;
     if (!read_tag(file, swap, &t) || t.small) return "";
     const std::uint64_t body = file_size - pos - 8;
-    bool found = false;
+    const std::string where = "the variable at byte " + std::to_string(pos);
     std::string why;
     if (t.type == kMiMatrix) {
-      why = check_matrix(file, swap, std::min(t.bytes, body), name, &found);
+      why = ArrayWalk(file, swap).array(std::min(t.bytes, body), where, 0);
     } else if (t.type == kMiCompressed) {
       // The inflated array cannot exceed zlib's largest ratio (about 1032:1) times the compressed bytes.
       const std::uint64_t packed = std::min(t.bytes, body);
       ZlibSource z(in, packed);
       Tag inner;
       if (read_tag(z, swap, &inner) && !inner.small && inner.type == kMiMatrix)
-        why = check_matrix(z, swap, std::min<std::uint64_t>(inner.bytes, 1100 * packed + 1000000), name, &found);
+        why = ArrayWalk(z, swap).array(std::min<std::uint64_t>(inner.bytes, 1100 * packed + 1000000), where, 0);
     }
-    if (!why.empty() || found) return why;
+    if (!why.empty()) return why;
     pos += 8 + (t.type == kMiCompressed ? t.bytes : t.stored);
   }
   return "";

@@ -1,14 +1,18 @@
-// A check of a MATLAB v5 file's sparse variable before libmatio reads it (io/src/mat_v5_check.cpp).
+// A check of every variable of a MATLAB v5 file before libmatio reads it (io/src/mat_v5_check.cpp).
 #pragma once
 
 #include <string>
 
 namespace dynid::internal {
 
-/// Walks the v5 data element of the sparse variable `name` in `path` (inflating it when compressed) and returns
-/// what is wrong when a sub-element's tag declares more bytes than its enclosing array holds ("" when every tag
-/// fits, or when the file is not v5 or holds no such variable). libmatio allocates what the ir, jc and data tags
-/// declare before reading them, so one damaged tag is a 4 GB allocation from a small file (fuzz_mat's seed).
-std::string v5_sparse_damage(const std::string& path, const std::string& name);
+/// Walks the top-level data elements of the v5 file `path` (inflating compressed ones) and, in each array, the
+/// tags libmatio sizes its allocations by: flags, dimensions and name; a numeric or char array's data; a sparse
+/// array's ir, jc and values; a cell's or struct's nested arrays, and a struct's field names (at most 64 levels).
+/// Returns what is wrong with the first variable where such a tag declares more bytes than its enclosing array
+/// holds, naming it ("variable 'K': its sparse column pointers (jc) declare 4294905868 bytes where the array holds
+/// 56"), or "" when every tag fits, the file ends early (libmatio reports that), or the file is not v5. libmatio
+/// allocates what a tag declares before reading it, so one damaged tag is a 4 GB allocation from a 364-byte file
+/// (fuzz_mat's seeds, both while listing a file's variables and while reading one).
+std::string v5_damage(const std::string& path);
 
 }  // namespace dynid::internal
