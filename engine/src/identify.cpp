@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <random>
 
 #include "dynid/engine/frf.hpp"
@@ -801,10 +802,10 @@ void lscf_select(const FrfData& frf_in, const LscfInput& in, const Identificatio
 // columns leave LSCF's poly-reference normal equations rank-deficient (the denominator's block for that input
 // undetermined, no pole stable over the orders). One note per reference left out. (An output channel that sees nothing
 // keeps its unit-RMS weight: on the identification benchmark's dev seeds, weighting such channels 0 changed one
-// marginal mode, found -> missed.)
+// marginal mode, found -> missed.) None when every reference is live (the caller keeps the FRFs it has).
 constexpr double kDeadPower = 1e-12;
 
-FrfData live_references(const FrfData& frf, std::vector<std::string>& notes) {
+std::optional<FrfData> live_references(const FrfData& frf, std::vector<std::string>& notes) {
   const int ni = frf.num_inputs(), no = frf.num_outputs();
   Eigen::VectorXd power(ni);
   for (int i = 0; i < ni; ++i) power[i] = frf.H.middleCols(i * no, no).squaredNorm();
@@ -823,9 +824,12 @@ FrfData live_references(const FrfData& frf, std::vector<std::string>& notes) {
                   power[i] > 0 ? 10 * std::log10(top / power[i]) : 300.0);
     notes.push_back(b);
   }
-  if (static_cast<int>(keep.size()) == ni) return frf;
-  FrfData live = frf;
-  live.inputs.clear();
+  if (static_cast<int>(keep.size()) == ni) return std::nullopt;
+  FrfData live;
+  live.frequency_hz = frf.frequency_hz;
+  live.outputs = frf.outputs;
+  live.window_decay = frf.window_decay;
+  live.source = frf.source;
   live.H.resize(frf.H.rows(), no * static_cast<Eigen::Index>(keep.size()));
   if (frf.coherence.size() > 0) live.coherence.resize(frf.coherence.rows(), live.H.cols());
   for (std::size_t j = 0; j < keep.size(); ++j) {
@@ -842,7 +846,8 @@ FrfData live_references(const FrfData& frf, std::vector<std::string>& notes) {
 IdentificationSummary identify_lscf(const FrfData& frf_all, const IdentificationOptions& o) {
   const auto t0 = checked_start(o, frf_all, "LSCF: ");
   std::vector<std::string> dropped;
-  const FrfData frf_in = live_references(frf_all, dropped);
+  const std::optional<FrfData> live = live_references(frf_all, dropped);
+  const FrfData& frf_in = live ? *live : frf_all;
   const LscfInput in = lscf_input(frf_in, o);
   const Eigen::VectorXd background = cmif(frf_in);
   IdentificationSummary s = lscf_head(frf_in, in, background);
