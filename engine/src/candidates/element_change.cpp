@@ -1,5 +1,5 @@
-// element_stiffness / element_mass: one element stiffer or softer (damage, a cover plate) or heavier or lighter
-// (added material) than modelled, as a fraction of its own stiffness (without geometric stiffness) or mass.
+// element_stiffness / element_mass: one element stiffer or softer (damage, a cover plate) or heavier (added
+// material) than modelled, as a fraction of its own stiffness (without geometric stiffness) or mass.
 #include "candidates/common.hpp"
 
 namespace dynid::internal {
@@ -20,7 +20,13 @@ class ElementChange : public Candidate {
     return std::string(mass_ ? "mass" : "stiffness") + " change of element " + std::to_string(eid_);
   }
   Site site() const override { return {{}, {eid_}}; }
-  std::vector<CandidateParameter> parameters() const override { return {{"fraction", 0.0, -0.95, 3.0, 0.5}}; }
+  // Stiffness: lost (damage) or gained (a cover plate). Mass: only gained. An element's own mass (rho A l) is what
+  // the model knows best, and material that is missing takes its stiffness with it (damage, which the stiffness
+  // kinds model); a mass loss alone has no mechanism, so, like the other mass kinds (lumped, distributed, sensor
+  // masses), element_mass adds mass.
+  std::vector<CandidateParameter> parameters() const override {
+    return {{"fraction", 0.0, mass_ ? 0.0 : -0.95, 3.0, 0.5}};
+  }
   std::vector<CustomTerm> terms(const Model& m, int first) const override {
     const Member mb = member(m, e_);
     return {mass_ ? linear_term(mb.dofs, {}, mb.M, first) : linear_term(mb.dofs, mb.Ks, {}, first)};
@@ -31,7 +37,7 @@ class ElementChange : public Candidate {
   std::string finding(const std::vector<PhysicalValue>& v) const override {
     const bool loss = v[0].value < 0;
     return "element " + std::to_string(eid_) +
-           (mass_ ? (loss ? " has lost mass: " : " carries added mass: ") : (loss ? " has lost stiffness (damage): " : " is stiffer than modelled: ")) +
+           (mass_ ? " carries added mass: " : (loss ? " has lost stiffness (damage): " : " is stiffer than modelled: ")) +
            with_std(v[0]);
   }
 
