@@ -229,6 +229,7 @@ std::vector<double> mode_snr(const Case& c, const VirtualTest& clean, const std:
 struct Score {
   int expected = 0, found = 0, reported = 0, spurious = 0;
   std::vector<double> damping_errors;
+  std::vector<double> frequency_z;  // |f identified - f true| / the stated frequency std, found modes
   double seconds = 0;
   std::string error;  // identification failed
   std::vector<std::string> missed, spurious_list;
@@ -286,7 +287,9 @@ Score score(const Case& c, const ModalData& truth, const std::vector<double>& sn
     const int r = found_t[static_cast<std::size_t>(t)];
     if (r >= 0) {
       ++sc.found;
-      sc.damping_errors.push_back(std::abs(s.modes[static_cast<std::size_t>(r)].damping_ratio / truth.damping_ratios[t] - 1));
+      const IdentifiedMode& m = s.modes[static_cast<std::size_t>(r)];
+      sc.damping_errors.push_back(std::abs(m.damping_ratio / truth.damping_ratios[t] - 1));
+      if (m.frequency_std_hz > 0) sc.frequency_z.push_back(std::abs(m.frequency_hz - truth.frequencies_hz[t]) / m.frequency_std_hz);
     } else {
       // The nearest reported mode, for the log.
       double best = 1e9, bm = 0, bz = 0;  // best: the signed relative error of the nearest
@@ -374,12 +377,13 @@ bool same_recordings(const std::vector<Recording>& a, const std::vector<Recordin
 
 struct Tally {
   int tests = 0, expected = 0, found = 0, reported = 0, spurious = 0, failed = 0;
-  std::vector<double> damping_errors;
+  std::vector<double> damping_errors, frequency_z;
   double seconds = 0;
   void add(const Score& s) {
     ++tests;
     expected += s.expected, found += s.found, reported += s.reported, spurious += s.spurious;
     damping_errors.insert(damping_errors.end(), s.damping_errors.begin(), s.damping_errors.end());
+    frequency_z.insert(frequency_z.end(), s.frequency_z.begin(), s.frequency_z.end());
     seconds += s.seconds;
     failed += !s.error.empty();
   }
@@ -509,6 +513,16 @@ int main(int argc, char** argv) {
   fmt::print("{}\n", row("all, one file per test", all[0]));
   if (!one_layout) fmt::print("{}\n", row("all, one file per channel", all[1]));
   for (const auto& [key, t] : by_key) fmt::print("{}\n", row(key, t));
+  // The stated frequency std against the error (the truth is the simulation's model): calibrated, 68 % of the
+  // found modes lie within 1 sigma and the median |error| / sigma is 0.67 (a normal's).
+  for (const auto& [key, t] : by_key) {
+    if (key.rfind("excitation", 0) != 0 || t.frequency_z.empty()) continue;
+    const auto within = std::count_if(t.frequency_z.begin(), t.frequency_z.end(), [](double z) { return z <= 1; });
+    fmt::print("\nfrequency std, {}: the error within 1 sigma in {:.0f} % of {} found modes (68 % if calibrated), "
+               "median |error| / sigma {:.2f} (0.67)", key, 100.0 * static_cast<double>(within) / static_cast<double>(t.frequency_z.size()),
+               t.frequency_z.size(), median(t.frequency_z));
+  }
+  fmt::print("\n");
   if (!one_layout) fmt::print("\nread back identically from both layouts: {} of {} tests\n", equal_layouts, compared);
   if (all[0].failed) fmt::print("identification failed (error) in {} tests\n", all[0].failed);
   return 0;
