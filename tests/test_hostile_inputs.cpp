@@ -154,7 +154,9 @@ TEST(HostileInputs, MatDamagedHeaderWhileListing) {
   // libmatio's Mat_VarReadNextInfo allocated them while dynid listed the variables for an error message (26.6 s
   // under ASan). Every variable's tags are now checked when the file is opened.
   const std::string seed = test::CasesDir() + "/../fuzz/corpus/fuzz_mat/damaged-dims-listing.mat";
-  EXPECT_HAS(ErrorOf([&] { MatFile{seed}; }), "the variable at byte 128: its dimensions declare 1633943556 bytes where the array holds 337: the file is damaged");
+  EXPECT_HAS(ErrorOf([&] { MatFile{seed}; }),
+             "the variable at byte 128: its dimensions declare 1633943556 bytes where the array holds 337: the file is "
+             "damaged");
 }
 
 // A v5 file (little-endian) holding the cell array c = {[1 2]}; `data_bytes` is what the double's data tag declares

@@ -289,7 +289,8 @@ Score score(const Case& c, const ModalData& truth, const std::vector<double>& sn
       ++sc.found;
       const IdentifiedMode& m = s.modes[static_cast<std::size_t>(r)];
       sc.damping_errors.push_back(std::abs(m.damping_ratio / truth.damping_ratios[t] - 1));
-      if (m.frequency_std_hz > 0) sc.frequency_z.push_back(std::abs(m.frequency_hz - truth.frequencies_hz[t]) / m.frequency_std_hz);
+      if (m.frequency_std_hz > 0)
+        sc.frequency_z.push_back(std::abs(m.frequency_hz - truth.frequencies_hz[t]) / m.frequency_std_hz);
     } else {
       // The nearest reported mode, for the log.
       double best = 1e9, bm = 0, bz = 0;  // best: the signed relative error of the nearest
@@ -518,9 +519,11 @@ int main(int argc, char** argv) {
   for (const auto& [key, t] : by_key) {
     if (key.rfind("excitation", 0) != 0 || t.frequency_z.empty()) continue;
     const auto within = std::count_if(t.frequency_z.begin(), t.frequency_z.end(), [](double z) { return z <= 1; });
-    fmt::print("\nfrequency std, {}: the error within 1 sigma in {:.0f} % of {} found modes (68 % if calibrated), "
-               "median |error| / sigma {:.2f} (0.67)", key, 100.0 * static_cast<double>(within) / static_cast<double>(t.frequency_z.size()),
-               t.frequency_z.size(), median(t.frequency_z));
+    fmt::print(
+        "\nfrequency std, {}: the error within 1 sigma in {:.0f} % of {} found modes (68 % if calibrated), "
+        "median |error| / sigma {:.2f} (0.67)",
+        key, 100.0 * static_cast<double>(within) / static_cast<double>(t.frequency_z.size()), t.frequency_z.size(),
+        median(t.frequency_z));
   }
   fmt::print("\n");
   if (!one_layout) fmt::print("\nread back identically from both layouts: {} of {} tests\n", equal_layouts, compared);

@@ -215,8 +215,8 @@ class ArrayWalk {
     Tag t;
     if (!next(left, &t) || t.small || t.type != kMiMatrix) return stop();
     if (over(t, *left))
-      return who + ": its array element declares " + std::to_string(t.bytes) + " bytes where the enclosing array holds " +
-             std::to_string(*left);
+      return who + ": its array element declares " + std::to_string(t.bytes) +
+             " bytes where the enclosing array holds " + std::to_string(*left);
     const std::uint64_t n = std::min(t.stored, *left);
     const std::string why = array(n, who, depth + 1);
     if (!why.empty() || end_) return why;

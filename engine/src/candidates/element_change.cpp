@@ -37,7 +37,8 @@ class ElementChange : public Candidate {
   std::string finding(const std::vector<PhysicalValue>& v) const override {
     const bool loss = v[0].value < 0;
     return "element " + std::to_string(eid_) +
-           (mass_ ? " carries added mass: " : (loss ? " has lost stiffness (damage): " : " is stiffer than modelled: ")) +
+           (mass_ ? " carries added mass: "
+                  : (loss ? " has lost stiffness (damage): " : " is stiffer than modelled: ")) +
            with_std(v[0]);
   }
 
