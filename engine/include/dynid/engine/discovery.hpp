@@ -174,7 +174,7 @@ const char* to_string(Verdict v);  // "consistent", "missing_physics", "inconclu
 
 /// Why the verdict is what it is.
 enum class VerdictReason {
-  kWithinNoise,      ///< consistent: the model fits the data within the noise, no explanation decisively better
+  kWithinNoise,      ///< consistent: the model fits the data within the noise
   kExplained,        ///< missing physics: the findings are decisive and explain the misfit
   kNothingDecisive,  ///< inconclusive: a misfit no candidate explains decisively
   kPartlyExplained,  ///< inconclusive: the best explanation leaves most of the misfit
