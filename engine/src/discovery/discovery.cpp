@@ -347,8 +347,13 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   S.eigen_solves += recal.evaluations;
 
   // ---- grow and prune the explanation ----
-  // Also when the model is within the noise: an explanation decisive against it still says something is missing.
-  const Selection sel = select(p, singles, S.before);
+  Selection sel;
+  if (!consistent) sel = select(p, singles, S.before);
+  else {
+    sel.chi2_best = chi2_0;
+    for (const SetFit& f : singles)
+      if (f.ok && f.chi2 < sel.chi2_best) sel.chi2_best = f.chi2;
+  }
   S.eigen_solves += sel.eigen_solves;
   {
     const ErrorScale es = sel.fit.set.empty() ? error_scale(p, chi2_0, sc.chi2_frequency) : error_scale(p, sel.fit);
@@ -365,10 +370,7 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   S.recalibration = score_fit(p, recal, 0, sel.chi2_best);
 
   // ---- decide ----
-  // Within the noise and no explanation decisive against the model as given: nothing is missing. A chi-square
-  // over all modes dilutes one mode's deviation that a specific effect explains decisively; then the evidence
-  // speaks (the omnibus test alone has no power against a targeted alternative).
-  if (consistent && sel.fit.set.empty()) {
+  if (consistent) {
     S.verdict = Verdict::kConsistent;
     S.reason = VerdictReason::kWithinNoise;
     return finish();
