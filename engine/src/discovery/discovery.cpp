@@ -348,8 +348,9 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
 
   // ---- grow and prune the explanation ----
   Selection sel;
-  if (!consistent) sel = select(p, singles, S.before);
-  else {
+  if (!consistent) {
+    sel = select(p, singles, S.before);
+  } else {
     sel.chi2_best = chi2_0;
     for (const SetFit& f : singles)
       if (f.ok && f.chi2 < sel.chi2_best) sel.chi2_best = f.chi2;
