@@ -143,7 +143,7 @@ struct MatFile::Handle {
       const double file_bytes = static_cast<double>(std::filesystem::file_size(path, ec));
       const double bytes =
           static_cast<double>(numel(info.get(), max)) * static_cast<double>(Mat_SizeOfClass(info->class_type));
-      if (!ec && bytes > 1100.0 * file_bytes + 1e6)
+      if (!ec && bytes > internal::max_inflated_bytes(file_bytes))
         fail(path, name, "declares a " + dims_text(info.get()) + " array (" + limit_text(bytes) + " bytes) in a file of " +
                              limit_text(file_bytes) + " bytes: the file is damaged; save it again from MATLAB or SciPy");
     }

@@ -288,7 +288,9 @@ std::string v5_damage(const std::string& path) {
       ZlibSource z(in, packed);
       Tag inner;
       if (read_tag(z, swap, &inner) && !inner.small && inner.type == kMiMatrix)
-        why = ArrayWalk(z, swap).array(std::min<std::uint64_t>(inner.bytes, 1100 * packed + 1000000), where, 0);
+        why = ArrayWalk(z, swap).array(
+            std::min(inner.bytes, static_cast<std::uint64_t>(max_inflated_bytes(static_cast<double>(packed)))), where,
+            0);
     }
     if (!why.empty()) return why;
     pos += 8 + (t.type == kMiCompressed ? t.bytes : t.stored);

@@ -5,6 +5,10 @@
 
 namespace dynid::internal {
 
+/// The most bytes `packed` bytes of a .mat file can hold once inflated: zlib's largest ratio (about 1032:1) with a
+/// margin, plus 1 MB for an uncompressed file's headers.
+inline double max_inflated_bytes(double packed) { return 1100.0 * packed + 1e6; }
+
 /// Walks the top-level data elements of the v5 file `path` (inflating compressed ones) and, in each array, the
 /// tags libmatio sizes its allocations by: flags, dimensions and name; a numeric or char array's data; a sparse
 /// array's ir, jc and values; a cell's or struct's nested arrays, and a struct's field names (at most 64 levels).
