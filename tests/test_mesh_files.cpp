@@ -4,8 +4,6 @@
 #include <fstream>
 #include <sstream>
 
-#include <unistd.h>
-
 #include "dynid/engine/modal.hpp"
 #include "dynid/io/case_file.hpp"
 #include "dynid/io/mesh_files.hpp"
@@ -14,20 +12,14 @@
 namespace dynid {
 namespace {
 
-namespace fs = std::filesystem;
-
-
 std::string MeshDir() { return test::CasesDir() + "/../tests/data/mesh"; }
 
 using test::Slurp;
 
-/// Writes `text` to a file in a scratch folder and returns its path.
+/// Writes `text` to a file in a scratch folder (removed when the test program ends) and returns its path.
 std::string Write(const std::string& name, const std::string& text) {
-  static const fs::path dir = fs::path(::testing::TempDir()) / ("dynid_mesh_files_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  const std::string p = (dir / name).string();
-  std::ofstream(p, std::ios::binary) << text;
-  return p;
+  static const test::ScratchDir dir("mesh-files");
+  return dir.write(name, text);
 }
 
 std::string Replace(std::string s, const std::string& from, const std::string& to) {
