@@ -1,10 +1,12 @@
 // Eigen-solvers: the sparse shift-invert Lanczos path against the dense path (1e-8 relative) on every model
 // small enough for the dense path; free-free structures, singular mass matrices, band mode, mechanisms.
 #include <Eigen/Dense>
+#include <random>
 
 #include "dynid/engine/modal.hpp"
 #include "dynid/io/case_file.hpp"
 #include "dynid/mesh/generators.hpp"
+#include "internal/lanczos.hpp"
 #include "test_util.hpp"
 
 namespace dynid {
@@ -170,6 +172,47 @@ TEST(Eigen, RejectsNonFiniteMatrices) {
   K.insert(1, 1) = std::nan("");
   M.insert(0, 0) = M.insert(1, 1) = 1;
   EXPECT_THROW(solve_eigen(K, M, EigenOptions{}), InputError);
+}
+
+// The thick-restart Lanczos on operators whose answer is known. A diagonal operator with 5 distinct values,
+// each 40 times: the Krylov space of any start vector has dimension 5, so the run meets invariant subspaces and
+// must continue from fresh vectors to find the 8 largest eigenvalues with their multiplicity (4 -> 40 x 4, ...).
+// A random symmetric operator: Ritz values against Eigen's dense solver, Ritz vectors orthonormal with small
+// residuals. Tolerances: the Lanczos tolerance 1e-10 relative, 1e-9 on the residual norm of unit vectors.
+TEST(Lanczos, RepeatedEigenvaluesAndADenseReference) {
+  const Eigen::Index n = 200;
+  Eigen::VectorXd d(n);
+  for (Eigen::Index i = 0; i < n; ++i) d[i] = 1.0 + static_cast<double>(i % 5);
+  auto diag = [&](const double* x, double* y) {
+    for (Eigen::Index i = 0; i < n; ++i) y[i] = d[i] * x[i];
+  };
+  const Eigen::VectorXd v0 = Eigen::VectorXd::Ones(n);
+  const detail::LanczosResult r = detail::thick_restart_lanczos(diag, n, v0, detail::LanczosOptions{8, 24, 100, 1e-10});
+  ASSERT_TRUE(r.converged);
+  ASSERT_EQ(r.theta.size(), 8);
+  for (Eigen::Index i = 0; i < 8; ++i) EXPECT_NEAR(r.theta[i], 5.0, 1e-9) << i;
+  EXPECT_LT((r.Y.transpose() * r.Y - Eigen::MatrixXd::Identity(8, 8)).cwiseAbs().maxCoeff(), 1e-10);
+
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> g;
+  Eigen::MatrixXd A(n, n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = 0; j < n; ++j) A(i, j) = g(rng);
+  A = (A + A.transpose()).eval();
+  auto dense = [&](const double* x, double* y) {
+    Eigen::Map<Eigen::VectorXd>(y, n).noalias() = A * Eigen::Map<const Eigen::VectorXd>(x, n);
+  };
+  Eigen::VectorXd start(n);
+  for (Eigen::Index i = 0; i < n; ++i) start[i] = g(rng);
+  const detail::LanczosResult q =
+      detail::thick_restart_lanczos(dense, n, start, detail::LanczosOptions{10, 30, 500, 1e-10});
+  ASSERT_TRUE(q.converged);
+  const Eigen::VectorXd exact = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(A).eigenvalues().reverse();
+  for (Eigen::Index i = 0; i < 10; ++i) {
+    EXPECT_NEAR(q.theta[i], exact[i], 1e-10 * std::abs(exact[i])) << i;
+    EXPECT_LT((A * q.Y.col(i) - q.theta[i] * q.Y.col(i)).norm(), 1e-9 * std::abs(exact[0])) << i;
+  }
+  EXPECT_LT((q.Y.transpose() * q.Y - Eigen::MatrixXd::Identity(10, 10)).cwiseAbs().maxCoeff(), 1e-10);
 }
 
 }  // namespace

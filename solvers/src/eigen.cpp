@@ -1,6 +1,5 @@
 #include "dynid/solvers/eigen.hpp"
 
-#include <Spectra/SymEigsSolver.h>
 #include <Spectra/SymGEigsShiftSolver.h>
 
 #include <Eigen/Dense>
@@ -16,6 +15,7 @@
 #include "dynid/solvers/cholmod.hpp"
 #include "dynid/solvers/distributed.hpp"
 #include "internal/eigen_detail.hpp"
+#include "internal/lanczos.hpp"
 
 namespace dynid {
 
@@ -581,16 +581,15 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
       report(opt, "lanczos", -1);
       if (standard) {
         TransformedOperator op(F, Mp, Yr);
-        Spectra::SymEigsSolver<TransformedOperator> eigs(op, want, ncv);
         op.perform_op(x0.data(), v0.data());
-        eigs.init(v0.data());
-        if (!lanczos(sum, [&] { eigs.compute(Spectra::SortRule::LargestAlge, opt.max_restarts, opt.tolerance, Spectra::SortRule::LargestAlge); }))
-          return sol;
+        const detail::LanczosResult lr =
+            detail::thick_restart_lanczos([&](const double* x, double* y) { op.perform_op(x, y); }, n, v0,
+                                          detail::LanczosOptions{want, ncv, opt.max_restarts, opt.tolerance});
         sum.solves += op.count();
-        sum.restarts += static_cast<int>(eigs.num_iterations());
-        ok = eigs.info() == Spectra::CompInfo::Successful;
-        const Eigen::VectorXd th = eigs.eigenvalues();  // descending theta = ascending lambda
-        const Eigen::MatrixXd Y = eigs.eigenvectors();
+        sum.restarts += lr.restarts;
+        ok = lr.converged;
+        const Eigen::VectorXd& th = lr.theta;  // descending theta = ascending lambda
+        const Eigen::MatrixXd& Y = lr.Y;
         ev.resize(th.size());
         F.backward_block(Y, &V);
         for (Eigen::Index k = 0; k < th.size(); ++k) {

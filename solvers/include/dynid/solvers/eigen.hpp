@@ -1,8 +1,8 @@
 // dynid/solvers/eigen.hpp -- the generalized symmetric eigenproblem K phi = lambda M phi.
 //
-// Sparse path: shift-invert Lanczos (Spectra SymGEigsShiftSolver, ShiftInvert mode) on a CHOLMOD factorization
-// of K - sigma M; the operator is (K - sigma M)^{-1} M in the M inner product, so M may be singular (massless
-// DOFs): those directions map to infinite eigenvalues, which shift-invert never returns.
+// Sparse path: shift-invert Lanczos on a CHOLMOD factorization of K - sigma M (the standard form below, or Spectra
+// SymGEigsShiftSolver's (K - sigma M)^{-1} M in the M inner product), so M may be singular (massless DOFs): those
+// directions map to infinite eigenvalues, which shift-invert never returns.
 // Dense path: LAPACK-style dense solvers (Eigen), for small models and as an independent cross-check.
 //
 // Modes are mass-normalised (phi^T M phi = 1), sorted by eigenvalue, with a sign convention (the entry of
@@ -40,15 +40,16 @@ struct EigenOptions {
   /// zero-energy modes as rigid by their residual ||K phi|| <= rigid_residual_tolerance * ||K||_1 ||phi||.
   bool allow_singular_stiffness = false;
   double rigid_residual_tolerance = 1e-9;
-  /// Lanczos basis size (Spectra's ncv); 0 = min(n, max(2 nev + 1, nev + 20)).
+  /// Lanczos basis size (ncv); 0 = min(n, max(2 nev + 1, nev + 20)).
   int subspace = 0;
   /// Restart limit and relative Ritz-value tolerance: stop when every wanted Ritz value theta satisfies
   /// |theta - theta_exact| <= tolerance * |theta| (Spectra's criterion).
   int max_restarts = 500;
   double tolerance = 1e-10;
   /// How the shift-invert Lanczos run is set up (lowest-modes mode; band mode always uses kGeneralized):
-  ///  kCholeskyStandard: Spectra SymEigsSolver on C = L^{-1} P M P^T L^{-T} (P (K - sigma M) P^T = L L^T), one
-  ///    solve and one M product per step, Euclidean orthogonalisation. Default: several times faster.
+  ///  kCholeskyStandard: thick-restart Lanczos (solvers/src/internal/lanczos.hpp: classical Gram-Schmidt with a
+  ///    second pass only when needed) on C = L^{-1} P M P^T L^{-T} (P (K - sigma M) P^T = L L^T), one solve and
+  ///    one M product per step, Euclidean orthogonalisation. Default: several times faster.
   ///  kGeneralized: Spectra SymGEigsShiftSolver (shift-invert mode) with (K - sigma M)^{-1} M in the M inner
   ///    product; every inner product costs an M product.
   enum class Formulation { kCholeskyStandard, kGeneralized };

@@ -1,0 +1,146 @@
+#include "internal/lanczos.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+
+namespace dynid::detail {
+
+namespace {
+
+constexpr double kEta = 0.7071067811865476;  // DGKS: repeat the pass when it removed more than 1 - 1/sqrt(2)
+
+// w <- w - V h with h = V^T w over the first `cols` columns, repeated while a pass shrinks w below kEta of its
+// norm before the pass (at most 3 passes). Adds the coefficients to `h` (size cols, zeroed unless `keep`) and
+// returns ||w||.
+double orthogonalize(const Eigen::MatrixXd& V, Eigen::Index cols, Eigen::VectorXd& w, Eigen::VectorXd& h,
+                     bool keep = false) {
+  if (!keep) h.setZero(cols);
+  double before = w.norm();
+  for (int pass = 0; pass < 3; ++pass) {
+    const Eigen::VectorXd c = V.leftCols(cols).transpose() * w;
+    w.noalias() -= V.leftCols(cols) * c;
+    h += c;
+    const double after = w.norm();
+    if (after >= kEta * before) return after;
+    before = after;
+  }
+  return w.norm();
+}
+
+}  // namespace
+
+LanczosResult thick_restart_lanczos(const std::function<void(const double* x, double* y)>& op, Eigen::Index n,
+                                    const Eigen::VectorXd& v0, const LanczosOptions& o) {
+  LanczosResult out;
+  const int m = o.ncv, nev = o.nev;
+  const double eps = std::numeric_limits<double>::epsilon();
+  const double eps23 = std::pow(eps, 2.0 / 3.0);
+  Eigen::MatrixXd V(n, m), T = Eigen::MatrixXd::Zero(m, m), kept;
+  Eigen::VectorXd w(n), h;
+  std::mt19937_64 rng(20241121);
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  double anorm = 0;  // largest |T| entry seen: the scale of a breakdown
+
+  // A unit vector orthogonal to the first `cols` columns (a restart after an invariant subspace).
+  auto fresh = [&](Eigen::Index cols) {
+    for (int attempt = 0; attempt < 4; ++attempt) {
+      for (Eigen::Index i = 0; i < n; ++i) w[i] = uni(rng);
+      op(w.data(), V.col(cols).data());  // in the operator's range (purified as the start vector is)
+      w = V.col(cols);
+      const double before = w.norm();
+      const double nrm = orthogonalize(V, cols, w, h);
+      if (nrm > 1e-8 * before) {
+        V.col(cols) = w / nrm;
+        ++out.applications;
+        return true;
+      }
+    }
+    return false;
+  };
+
+  double beta = v0.norm();
+  if (!(beta > 0)) return out;
+  V.col(0) = v0 / beta;
+  int k = 0;  // kept Ritz vectors at the start of the sweep
+  Eigen::VectorXd f(n);
+  for (out.restarts = 0; out.restarts <= o.max_restarts; ++out.restarts) {
+    // Extend the basis from column k to m: T = V^T A V as the passes compute it.
+    for (int j = k; j < m; ++j) {
+      op(V.col(j).data(), w.data());
+      ++out.applications;
+      // The three-term recurrence first (cheap: two vectors), so that the pass over the whole basis removes only
+      // the rounding's loss of orthogonality and one pass suffices (DGKS); the first step after a restart couples
+      // to every kept vector and goes straight to the full passes.
+      h.setZero(j + 1);
+      if (j > k) {
+        h[j - 1] = T(j, j - 1);
+        w.noalias() -= h[j - 1] * V.col(j - 1);
+        h[j] = V.col(j).dot(w);
+        w.noalias() -= h[j] * V.col(j);
+      }
+      const double nrm = orthogonalize(V, j + 1, w, h, true);
+      if (!std::isfinite(nrm) || !h.allFinite()) return out;  // the operator broke down (e.g. a NaN solve)
+      T.col(j).head(j + 1) = h;
+      T.row(j).head(j + 1) = h.transpose();
+      anorm = std::max(anorm, h.cwiseAbs().maxCoeff());
+      beta = nrm;
+      if (j + 1 == m) break;
+      if (beta <= std::sqrt(static_cast<double>(n)) * eps * anorm) {  // an invariant subspace
+        beta = 0;
+        if (!fresh(j + 1)) return out;
+      } else {
+        V.col(j + 1) = w / beta;
+      }
+      T(j + 1, j) = T(j, j + 1) = beta;
+    }
+    f = w;  // the residual direction, norm beta
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(T);
+    // Descending Ritz values and their coordinates.
+    Eigen::VectorXd theta = es.eigenvalues().reverse();
+    Eigen::MatrixXd Yt = es.eigenvectors().rowwise().reverse();
+    const double tmax = std::max(std::abs(theta[0]), std::abs(theta[m - 1]));
+    int nconv = 0;
+    std::vector<char> conv(static_cast<std::size_t>(nev), 0);
+    for (int i = 0; i < nev; ++i) {
+      const double resid = std::abs(beta * Yt(m - 1, i));
+      if (resid <= o.tolerance * std::max(std::abs(theta[i]), eps23 * tmax))
+        conv[static_cast<std::size_t>(i)] = 1, ++nconv;
+    }
+    if (nconv == nev || out.restarts == o.max_restarts) {
+      std::vector<int> keep;
+      for (int i = 0; i < nev; ++i)
+        if (conv[static_cast<std::size_t>(i)]) keep.push_back(i);
+      out.theta.resize(static_cast<Eigen::Index>(keep.size()));
+      Eigen::MatrixXd Ys(m, static_cast<Eigen::Index>(keep.size()));
+      for (std::size_t q = 0; q < keep.size(); ++q) {
+        out.theta[static_cast<Eigen::Index>(q)] = theta[keep[q]];
+        Ys.col(static_cast<Eigen::Index>(q)) = Yt.col(keep[q]);
+      }
+      out.Y.noalias() = V * Ys;
+      out.converged = nconv == nev;
+      return out;
+    }
+    // Thick restart: keep the best k Ritz vectors and continue from the residual.
+    k = std::min(m - 2, nev + std::min(nconv, (m - nev) / 2));
+    if (kept.cols() == 0) kept.resize(n, std::min(m - 2, nev + (m - nev) / 2));  // once, at the largest k
+    kept.leftCols(k).noalias() = V * Yt.leftCols(k);
+    V.leftCols(k) = kept.leftCols(k);
+    T.setZero();
+    for (int i = 0; i < k; ++i) {
+      T(i, i) = theta[i];
+      T(i, k) = T(k, i) = beta * Yt(m - 1, i);
+    }
+    if (beta <= std::sqrt(static_cast<double>(n)) * eps * anorm) {
+      for (int i = 0; i < k; ++i) T(i, k) = T(k, i) = 0;
+      if (!fresh(k)) return out;
+    } else {
+      V.col(k) = f / beta;
+    }
+  }
+  return out;
+}
+
+}  // namespace dynid::detail
