@@ -51,7 +51,11 @@ CholmodFactor::CholmodFactor(Kind kind) : impl_(std::make_unique<Impl>()), kind_
   c.print = 0;
   c.error_handler = nullptr;
   if (kind == Kind::kSupernodalLLt) {
-    c.supernodal = CHOLMOD_SUPERNODAL;
+    // CHOLMOD's own choice (supernodal_switch: supernodal when the factorization's flops exceed 40 per entry of
+    // L): a factor with short columns (members split into chains of elements) is solved in plain loops at memory
+    // speed, where supernodal solves spend their time in one small BLAS call per supernode (bench/README.md:
+    // 995,100-DOF plane frame, 66 -> 26 ms per solve).
+    c.supernodal = CHOLMOD_AUTO;
     c.final_ll = 1;
   } else {
     c.supernodal = CHOLMOD_SIMPLICIAL;

@@ -18,7 +18,8 @@ namespace dynid {
 class CholmodFactor {
  public:
   enum class Kind {
-    kSupernodalLLt,  ///< supernodal Cholesky L L^T (BLAS-3); requires a positive definite matrix
+    kSupernodalLLt,  ///< Cholesky L L^T, supernodal (BLAS-3) where CHOLMOD's rule finds enough flops per entry of
+                     ///< L, else simplicial; requires a positive definite matrix
     kSimplicialLDLt  ///< simplicial L D L^T; works for indefinite matrices and gives the inertia
   };
   explicit CholmodFactor(Kind kind = Kind::kSupernodalLLt);
