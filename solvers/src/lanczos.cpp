@@ -44,6 +44,7 @@ LanczosResult thick_restart_lanczos(const std::function<void(const double* x, do
   std::mt19937_64 rng(20241121);
   std::uniform_real_distribution<double> uni(-1.0, 1.0);
   double anorm = 0;  // largest |T| entry seen: the scale of a breakdown
+  auto negligible = [&](double b) { return b <= std::sqrt(static_cast<double>(n)) * eps * anorm; };
 
   // A unit vector orthogonal to the first `cols` columns (a restart after an invariant subspace).
   auto fresh = [&](Eigen::Index cols) {
@@ -55,7 +56,6 @@ LanczosResult thick_restart_lanczos(const std::function<void(const double* x, do
       const double nrm = orthogonalize(V, cols, w, h);
       if (nrm > 1e-8 * before) {
         V.col(cols) = w / nrm;
-        ++out.applications;
         return true;
       }
     }
@@ -66,12 +66,10 @@ LanczosResult thick_restart_lanczos(const std::function<void(const double* x, do
   if (!(beta > 0)) return out;
   V.col(0) = v0 / beta;
   int k = 0;  // kept Ritz vectors at the start of the sweep
-  Eigen::VectorXd f(n);
   for (out.restarts = 0; out.restarts <= o.max_restarts; ++out.restarts) {
     // Extend the basis from column k to m: T = V^T A V as the passes compute it.
     for (int j = k; j < m; ++j) {
       op(V.col(j).data(), w.data());
-      ++out.applications;
       // The three-term recurrence first (cheap: two vectors), so that the pass over the whole basis removes only
       // the rounding's loss of orthogonality and one pass suffices (DGKS); the first step after a restart couples
       // to every kept vector and goes straight to the full passes.
@@ -89,7 +87,7 @@ LanczosResult thick_restart_lanczos(const std::function<void(const double* x, do
       anorm = std::max(anorm, h.cwiseAbs().maxCoeff());
       beta = nrm;
       if (j + 1 == m) break;
-      if (beta <= std::sqrt(static_cast<double>(n)) * eps * anorm) {  // an invariant subspace
+      if (negligible(beta)) {  // an invariant subspace
         beta = 0;
         if (!fresh(j + 1)) return out;
       } else {
@@ -97,7 +95,7 @@ LanczosResult thick_restart_lanczos(const std::function<void(const double* x, do
       }
       T(j + 1, j) = T(j, j + 1) = beta;
     }
-    f = w;  // the residual direction, norm beta
+    // w: the residual direction, norm beta (untouched until the restart below)
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(T);
     // Descending Ritz values and their coordinates.
     Eigen::VectorXd theta = es.eigenvalues().reverse();
@@ -134,11 +132,11 @@ LanczosResult thick_restart_lanczos(const std::function<void(const double* x, do
       T(i, i) = theta[i];
       T(i, k) = T(k, i) = beta * Yt(m - 1, i);
     }
-    if (beta <= std::sqrt(static_cast<double>(n)) * eps * anorm) {
+    if (negligible(beta)) {
       for (int i = 0; i < k; ++i) T(i, k) = T(k, i) = 0;
       if (!fresh(k)) return out;
     } else {
-      V.col(k) = f / beta;
+      V.col(k) = w / beta;
     }
   }
   return out;

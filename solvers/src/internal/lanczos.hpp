@@ -16,7 +16,6 @@ struct LanczosOptions {
 struct LanczosResult {
   Eigen::VectorXd theta;  ///< converged Ritz values, descending (up to nev)
   Eigen::MatrixXd Y;      ///< their Ritz vectors (n x theta.size()), orthonormal
-  int applications = 0;   ///< operator applications
   int restarts = 0;
   bool converged = false;  ///< all nev converged
 };
