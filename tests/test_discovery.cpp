@@ -209,6 +209,45 @@ TEST(DiscoveryStages, FlexibleBaseThroughEachStage) {
   EXPECT_EQ(sel.importance.size(), 1u);
 }
 
+// An effect fitted to nothing is never a finding. The portal's base is flexible (the misfit far above the
+// default noise); a global candidate is given the fit of finding nothing: its parameters at their nominal values,
+// the misfit the model's own. Its evidence still passes `decisive` (the model as given is scored at the noise alone,
+// while this fit is scored at its misfit's level), which once let such fits stand as lone findings (dev split:
+// self weight at load factor 0 +- 8, chi2 100.9 -> 100.9). The likelihood ratio against the model as given is 0,
+// so the selection must leave it out. Exact comparisons: the rule's inputs are set, not computed.
+TEST(DiscoveryStages, AnEffectFittedToNothingIsNoFinding) {
+  const Model analysis = make_frame2d(portal());
+  const ModalData meas = exact_modes(portal_on_base_spring(6.0e6), analysis, 6);
+  internal::Problem p;
+  DiscoverySummary S;
+  internal::prepare(analysis, meas, DiscoveryOptions{}, {}, &p, &S);
+  const internal::Screening sc = internal::screen(p);
+  p.n = p.modes * (1 + static_cast<int>(p.data.dofs.size()));
+  p.chi2_0 = sc.chi2;
+  p.chi2_0_frequency = sc.chi2_frequency;
+  ASSERT_GT(p.chi2_0_frequency, 10.0 * p.modes);
+  std::vector<char> forced(sc.paired.size());
+  for (std::size_t k = 0; k < sc.paired.size(); ++k) forced[k] = !sc.paired[k];
+  const FitQuality before = internal::quality_of(p, sc.model_hz, sc.mac, sc.chi2, forced);
+
+  int tested = 0;
+  for (const auto& c : p.library) {
+    if (!c->global()) continue;
+    internal::SetFit f = internal::fit_set(p, {c.get()});
+    if (!f.ok || f.at_bound) continue;
+    for (std::size_t q = 0; q < c->parameters().size(); ++q)
+      f.theta[0][static_cast<Eigen::Index>(q)] = c->parameters()[q].nominal;
+    f.chi2 = p.chi2_0;
+    f.chi2_frequency = p.chi2_0_frequency;
+    f.quality = before;
+    if (internal::log_evidence(p, f) < p.options.decisive) continue;  // the old rule would have refused it too
+    ++tested;
+    const internal::Selection sel = internal::select(p, {f}, before);
+    EXPECT_TRUE(sel.fit.set.empty()) << c->description() << " stood as a finding with its parameters at nominal";
+  }
+  EXPECT_GT(tested, 0) << "no global candidate's nothing-fit passed the evidence test: the case does not test the rule";
+}
+
 // Nothing missing: the data are the analysis model's own modes.
 TEST(Discovery, ExactDataOfTheModelIsConsistent) {
   const Model analysis = make_frame2d(portal());
