@@ -70,7 +70,8 @@ def main():
         eps.solve()
         n = eps.getConverged()
         vals = np.array(sorted(eps.getEigenvalue(i).real for i in range(n)))[: a.nev]
-        detail = "SLEPc Krylov-Schur, shift-and-invert, PETSc Cholesky via " + ("MUMPS" if a.peer == "slepc-mumps" else "CHOLMOD")
+        detail = "SLEPc Krylov-Schur, shift-and-invert, PETSc Cholesky via " + (
+            "MUMPS" if a.peer == "slepc-mumps" else "CHOLMOD")
     t_solve = time.perf_counter() - t0
     print(json.dumps({"peer": a.peer, "detail": detail, "time_s": t_solve, "load_s": t_load,
                       "peak_rss_mb": peak_mb(), "eigenvalues": sorted(float(v) for v in vals)}))
