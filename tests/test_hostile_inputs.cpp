@@ -159,6 +159,16 @@ TEST(HostileInputs, MatDamagedHeaderWhileListing) {
              "damaged");
 }
 
+TEST(HostileInputs, MatSmallElementArrayFlags) {
+  // fuzz_mat (CI, 2026-11-28): a 684-byte v5 file whose array flags sit in a small element (a 32-bit tag word
+  // with a size in its upper half); the walk used to stop there and leave the array to libmatio, which read on
+  // into dimensions of any size (13 s under ASan). Array flags are always two words in a full tag.
+  const std::string seed = test::CasesDir() + "/../fuzz/corpus/fuzz_mat/damaged-small-array-flags.mat";
+  EXPECT_HAS(ErrorOf([&] { MatFile{seed}; }),
+             "the variable at byte 128: its array flags are not the two 32-bit words a MAT-file holds: the file is "
+             "damaged");
+}
+
 // A v5 file (little-endian) holding the cell array c = {[1 2]}; `data_bytes` is what the double's data tag declares
 // (16 when intact).
 std::string CellFile(std::uint32_t data_bytes) {

@@ -140,7 +140,10 @@ class ArrayWalk {
       return who + " is nested more than " + std::to_string(kMaxDepth) + " levels deep (dynid reads at most that)";
     std::uint64_t left = size;
     Tag flags, dims, name;
-    if (!next(&left, &flags) || flags.small || flags.bytes < 8) return stop();
+    if (!next(&left, &flags)) return stop();
+    // Array flags are two 32-bit words in a full tag in every MAT-file writer's output; anything else is damage that
+    // libmatio would read on into dimensions of any size (fuzz_mat, 2026-11-28: a small-element flags tag).
+    if (flags.small || flags.bytes < 8) return who + ": its array flags are not the two 32-bit words a MAT-file holds";
     if (over(flags, left)) return who + declares("array flags", flags.bytes, left);
     unsigned char fb[8];
     if (!s_.read(fb, 8) || !pass(&left, flags, 8)) return stop();
