@@ -582,16 +582,16 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
       if (standard) {
         TransformedOperator op(F, Mp, Yr);
         op.perform_op(x0.data(), v0.data());
-        const detail::LanczosResult lr =
+        detail::LanczosResult lr =
             detail::thick_restart_lanczos([&](const double* x, double* y) { op.perform_op(x, y); }, n, v0,
                                           detail::LanczosOptions{want, ncv, opt.max_restarts, opt.tolerance});
         sum.solves += op.count();
         sum.restarts += lr.restarts;
         ok = lr.converged;
         const Eigen::VectorXd& th = lr.theta;  // descending theta = ascending lambda
-        const Eigen::MatrixXd& Y = lr.Y;
         ev.resize(th.size());
-        F.backward_block(Y, &V);
+        V = std::move(lr.Y);
+        F.backward_block(V, &V);  // in place: the Ritz vectors' storage becomes the modes' (B may be X)
         for (Eigen::Index k = 0; k < th.size(); ++k) {
           ev[k] = sigma + 1.0 / th[k];
           V.col(k) /= std::sqrt(th[k]);

@@ -31,6 +31,19 @@ double orthogonalize(const Eigen::MatrixXd& V, Eigen::Index cols, Eigen::VectorX
   return w.norm();
 }
 
+// V.leftCols(Y.cols()) <- V.leftCols(Y.rows()) Y, in place: by blocks of rows, each of which needs only its own
+// rows of V, so that a restart needs no second basis-sized buffer (240 MB on the 995,100-DOF plane frame).
+void rotate_in_place(Eigen::MatrixXd& V, const Eigen::Ref<const Eigen::MatrixXd>& Y) {
+  constexpr Eigen::Index kRows = 4096;
+  const Eigen::Index n = V.rows(), m = Y.rows(), k = Y.cols();
+  Eigen::MatrixXd block(std::min(kRows, n), k);
+  for (Eigen::Index r = 0; r < n; r += kRows) {
+    const Eigen::Index h = std::min(kRows, n - r);
+    block.topRows(h).noalias() = V.block(r, 0, h, m) * Y;
+    V.block(r, 0, h, k) = block.topRows(h);
+  }
+}
+
 }  // namespace
 
 LanczosResult thick_restart_lanczos(const std::function<void(const double* x, double* y)>& op, Eigen::Index n,
@@ -39,7 +52,7 @@ LanczosResult thick_restart_lanczos(const std::function<void(const double* x, do
   const int m = o.ncv, nev = o.nev;
   const double eps = std::numeric_limits<double>::epsilon();
   const double eps23 = std::pow(eps, 2.0 / 3.0);
-  Eigen::MatrixXd V(n, m), T = Eigen::MatrixXd::Zero(m, m), kept;
+  Eigen::MatrixXd V(n, m), T = Eigen::MatrixXd::Zero(m, m);
   Eigen::VectorXd w(n), h;
   std::mt19937_64 rng(20241121);
   std::uniform_real_distribution<double> uni(-1.0, 1.0);
@@ -118,15 +131,15 @@ LanczosResult thick_restart_lanczos(const std::function<void(const double* x, do
         out.theta[static_cast<Eigen::Index>(q)] = theta[keep[q]];
         Ys.col(static_cast<Eigen::Index>(q)) = Yt.col(keep[q]);
       }
-      out.Y.noalias() = V * Ys;
+      rotate_in_place(V, Ys);
+      V.conservativeResize(n, Ys.cols());
+      out.Y = std::move(V);
       out.converged = nconv == nev;
       return out;
     }
     // Thick restart: keep the best k Ritz vectors and continue from the residual.
     k = std::min(m - 2, nev + std::min(nconv, (m - nev) / 2));
-    if (kept.cols() == 0) kept.resize(n, std::min(m - 2, nev + (m - nev) / 2));  // once, at the largest k
-    kept.leftCols(k).noalias() = V * Yt.leftCols(k);
-    V.leftCols(k) = kept.leftCols(k);
+    rotate_in_place(V, Yt.leftCols(k));
     T.setZero();
     for (int i = 0; i < k; ++i) {
       T(i, i) = theta[i];

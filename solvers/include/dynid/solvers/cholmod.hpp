@@ -40,7 +40,7 @@ class CholmodFactor {
   void backward(const double* b, double* x) const;
   /// X = A^{-1} B for the k columns of B at once (blocked, BLAS-3).
   void solve_block(const Eigen::MatrixXd& B, Eigen::MatrixXd* X) const;
-  /// backward() for the k columns of B at once (blocked, BLAS-3): X = P^T L^{-T} B.
+  /// backward() for the k columns of B at once (blocked, BLAS-3): X = P^T L^{-T} B. X may be &B.
   void backward_block(const Eigen::MatrixXd& B, Eigen::MatrixXd* X) const;
   /// Row/column of A (original numbering) at which the last factorize() broke down, or -1.
   int failed_index() const { return failed_; }
