@@ -169,6 +169,16 @@ TEST(HostileInputs, MatSmallElementArrayFlags) {
              "damaged");
 }
 
+TEST(HostileInputs, MatSmallElementDeclaringMoreThanItHolds) {
+  // fuzz_mat (CI, 2026-11-28): a 317-byte v5 file whose compressed first variable has its dimensions in a small
+  // element that declares 2048 bytes (a small element holds at most 4); libmatio read on to a rank of 905,969,664
+  // and allocated 3.6 GB (12 s under ASan). Refused by name.
+  const std::string seed = test::CasesDir() + "/../fuzz/corpus/fuzz_mat/damaged-small-element-dimensions.mat";
+  EXPECT_HAS(ErrorOf([&] { MatFile{seed}; }),
+             "the variable at byte 128: its dimensions declare 2048 bytes where a small data element holds at most 4: "
+             "the file is damaged");
+}
+
 // A v5 file (little-endian) holding the cell array c = {[1 2]}; `data_bytes` is what the double's data tag declares
 // (16 when intact).
 std::string CellFile(std::uint32_t data_bytes) {

@@ -144,14 +144,14 @@ class ArrayWalk {
     // Array flags are two 32-bit words in a full tag in every MAT-file writer's output; anything else is damage that
     // libmatio would read on into dimensions of any size (fuzz_mat, 2026-11-28: a small-element flags tag).
     if (flags.small || flags.bytes < 8) return who + ": its array flags are not the two 32-bit words a MAT-file holds";
-    if (over(flags, left)) return who + declares("array flags", flags.bytes, left);
+    if (over(flags, left)) return who + declares("array flags", flags, left);
     unsigned char fb[8];
     if (!s_.read(fb, 8) || !pass(&left, flags, 8)) return stop();
     const std::uint32_t word = u32(fb, swap_);
     if (!next(&left, &dims)) return stop();
-    if (over(dims, left)) return who + declares("dimensions", dims.bytes, left);
+    if (over(dims, left)) return who + declares("dimensions", dims, left);
     if (!pass(&left, dims, 0) || !next(&left, &name)) return stop();
-    if (over(name, left)) return who + declares("name", name.bytes, left);
+    if (over(name, left)) return who + declares("name", name, left);
     std::string var;
     if (name.small) {
       var.assign(reinterpret_cast<const char*>(name.inline_data.data()), std::min<std::uint64_t>(name.bytes, 4));
@@ -178,8 +178,9 @@ class ArrayWalk {
   }
 
  private:
-  // A tag declaring more data than the array holds (a small element's data is inside its tag).
-  static bool over(const Tag& t, std::uint64_t left) { return !t.small && t.bytes > left; }
+  // A tag declaring more data than the array holds, or a small element declaring more than the 4 bytes its tag
+  // holds (libmatio reads such a count on as the element's size: fuzz_mat, 2026-11-28, a rank of 905,969,664).
+  static bool over(const Tag& t, std::uint64_t left) { return t.small ? t.bytes > 4 : t.bytes > left; }
   bool next(std::uint64_t* left, Tag* t) {
     if (*left < 8 || !read_tag(s_, swap_, t)) return false;
     *left -= 8;
@@ -196,9 +197,9 @@ class ArrayWalk {
     end_ = true;
     return "";
   }
-  static std::string declares(const std::string& what, std::uint64_t bytes, std::uint64_t holds) {
-    return ": its " + what + " declare " + std::to_string(bytes) + " bytes where the array holds " +
-           std::to_string(holds);
+  static std::string declares(const std::string& what, const Tag& t, std::uint64_t holds) {
+    return ": its " + what + " declare " + std::to_string(t.bytes) + " bytes where " +
+           (t.small ? std::string("a small data element holds at most 4") : "the array holds " + std::to_string(holds));
   }
   // `n` data elements in a row (a numeric or char array's real and imaginary data; a sparse array's ir, jc and
   // values): each must fit. The last one's data is left to the caller (a top-level array is not read further).
@@ -209,7 +210,7 @@ class ArrayWalk {
     for (int k = 0; k < n; ++k) {
       Tag t;
       if (!next(left, &t)) return stop();
-      if (over(t, *left)) return who + declares(sparse ? sparse_names[k] : numeric_names[k], t.bytes, *left);
+      if (over(t, *left)) return who + declares(sparse ? sparse_names[k] : numeric_names[k], t, *left);
       if (k + 1 < n && !pass(left, t, 0)) return stop();
     }
     return "";
@@ -237,13 +238,13 @@ class ArrayWalk {
     Tag t;
     if (object) {
       if (!next(left, &t)) return stop();
-      if (over(t, *left)) return who + declares("class name", t.bytes, *left);
+      if (over(t, *left)) return who + declares("class name", t, *left);
       if (!pass(left, t, 0)) return stop();
     }
     if (!next(left, &t) || !t.small || t.bytes != 4) return stop();
     const std::uint32_t length = u32(t.inline_data.data(), swap_);
     if (!next(left, &t)) return stop();
-    if (over(t, *left)) return who + declares("field names", t.bytes, *left);
+    if (over(t, *left)) return who + declares("field names", t, *left);
     if (!pass(left, t, 0)) return stop();
     const std::uint64_t n = length ? t.bytes / length : 0;
     for (std::uint64_t k = 1; k <= n && *left >= 8; ++k) {
