@@ -179,6 +179,17 @@ TEST(HostileInputs, MatSmallElementDeclaringMoreThanItHolds) {
              "the file is damaged");
 }
 
+TEST(HostileInputs, MatTopLevelArrayTooSmallForItsHeader) {
+  // fuzz_mat (CI, 2026-11-28): a 240-byte v5 file whose first variable is an array element of 0 bytes; libmatio
+  // read on into the next element as its header, to dimensions declaring 4 GB (an 8.4 GB malloc, 15 s under
+  // ASan). A top-level array takes 40 bytes at least.
+  const std::string seed = test::CasesDir() + "/../fuzz/corpus/fuzz_mat/damaged-empty-top-level-array.mat";
+  EXPECT_HAS(
+      ErrorOf([&] { MatFile{seed}; }),
+      "the variable at byte 128: its array element declares 0 bytes, fewer than the 40 its flags, dimensions and "
+      "name take: the file is damaged");
+}
+
 // A v5 file (little-endian) holding the cell array c = {[1 2]}; `data_bytes` is what the double's data tag declares
 // (16 when intact).
 std::string CellFile(std::uint32_t data_bytes) {

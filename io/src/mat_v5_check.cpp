@@ -138,6 +138,12 @@ class ArrayWalk {
   std::string array(std::uint64_t size, std::string who, int depth) {
     if (depth > kMaxDepth)
       return who + " is nested more than " + std::to_string(kMaxDepth) + " levels deep (dynid reads at most that)";
+    // Flags (16 bytes), dimensions (16 at least) and a name (8 at least): a smaller array element is damage that
+    // libmatio reads past, into whatever follows (fuzz_mat, 2026-11-28: a top-level array of 0 bytes, then
+    // dimensions declaring 4 GB). A nested array of 0 bytes is an empty cell or field.
+    if (size < 40 && (depth == 0 || size > 0))
+      return who + ": its array element declares " + std::to_string(size) +
+             " bytes, fewer than the 40 its flags, dimensions and name take";
     std::uint64_t left = size;
     Tag flags, dims, name;
     if (!next(&left, &flags)) return stop();
