@@ -190,6 +190,15 @@ TEST(HostileInputs, MatTopLevelArrayTooSmallForItsHeader) {
       "name take: the file is damaged");
 }
 
+TEST(HostileInputs, MatV4NameLongerThanTheFile) {
+  // fuzz_mat (2026-11-28): a 91-byte MATLAB v4 file whose second variable's name declares 1 GB; libmatio allocated
+  // and cleared it before reading (7 s, 1 GB without ASan). v4 headers are now checked as v5 tags are.
+  const std::string seed = test::CasesDir() + "/../fuzz/corpus/fuzz_mat/damaged-v4-name-length.mat";
+  EXPECT_HAS(
+      ErrorOf([&] { MatFile{seed}; }),
+      "the variable at byte 32: its name declares 1073741824 bytes where the file holds 39: the file is damaged");
+}
+
 // A v5 file (little-endian) holding the cell array c = {[1 2]}; `data_bytes` is what the double's data tag declares
 // (16 when intact).
 std::string CellFile(std::uint32_t data_bytes) {

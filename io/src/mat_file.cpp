@@ -166,8 +166,9 @@ MatFile::MatFile(const std::string& path, const ReaderLimits& limits)
     throw InputError(path + ": not a MATLAB .mat file (v4, v5/v7 or v7.3)" + matio_says() +
                      "; save it from MATLAB with save(..., '-v7') or '-v7.3', or from Python with scipy.io.savemat");
   // Before libmatio lists or reads anything: it sizes allocations by the v5 tags (internal/mat_v5_check.hpp).
-  if (Mat_GetVersion(h_->mat) == MAT_FT_MAT5) {
-    const std::string why = internal::v5_damage(path);
+  if (Mat_GetVersion(h_->mat) == MAT_FT_MAT5 || Mat_GetVersion(h_->mat) == MAT_FT_MAT4) {
+    const std::string why =
+        Mat_GetVersion(h_->mat) == MAT_FT_MAT5 ? internal::v5_damage(path) : internal::v4_damage(path);
     if (!why.empty()) throw InputError(path + ": " + why + ": the file is damaged; save it again from MATLAB or SciPy");
   }
 }

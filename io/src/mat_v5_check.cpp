@@ -308,4 +308,39 @@ std::string v5_damage(const std::string& path) {
   return "";
 }
 
+std::string v4_damage(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(0, std::ios::end);
+  const std::uint64_t file_size = static_cast<std::uint64_t>(in.tellg());
+  std::uint64_t pos = 0;
+  while (pos + 20 <= file_size) {
+    in.clear();
+    in.seekg(static_cast<std::streamoff>(pos));
+    unsigned char h[20];
+    if (!in.read(reinterpret_cast<char*>(h), 20)) return "";
+    // The type word MOPT (< 5000) says the byte order: read it both ways.
+    const bool swap = u32(h, false) >= 5000;
+    const std::uint32_t type = u32(h, swap);
+    if (type >= 5000) return "";  // not a v4 header: libmatio's own checks apply
+    const std::uint64_t rows = u32(h + 4, swap), cols = u32(h + 8, swap), imag = u32(h + 12, swap),
+                        namelen = u32(h + 16, swap);
+    static const std::uint64_t bytes_of[] = {8, 4, 4, 2, 2, 1};  // P: double, single, int32, int16, uint16, uint8
+    const std::uint32_t precision = (type / 10) % 10;
+    const std::string where = "the variable at byte " + std::to_string(pos);
+    if (precision > 5) return where + ": its type " + std::to_string(type) + " names no MAT-file v4 precision";
+    const std::uint64_t left = file_size - pos - 20;
+    if (namelen > left)
+      return where + ": its name declares " + std::to_string(namelen) + " bytes where the file holds " +
+             std::to_string(left);
+    // rows and cols are 32-bit: their product and the element size stay below 2^67; compare in long double.
+    const long double data =
+        static_cast<long double>(rows) * static_cast<long double>(cols) * bytes_of[precision] * (imag ? 2 : 1);
+    if (data > static_cast<long double>(left - namelen))
+      return where + ": its data declare " + std::to_string(rows) + " x " + std::to_string(cols) +
+             (imag ? " complex" : "") + " values where the file holds " + std::to_string(left - namelen) + " bytes";
+    pos += 20 + namelen + static_cast<std::uint64_t>(data);
+  }
+  return "";
+}
+
 }  // namespace dynid::internal

@@ -19,4 +19,9 @@ inline double max_inflated_bytes(double packed) { return 1100.0 * packed + 1e6; 
 /// (fuzz_mat's seeds, both while listing a file's variables and while reading one).
 std::string v5_damage(const std::string& path);
 
+/// The same for a MATLAB v4 file: every variable's name and data (rows x cols x element size, twice when complex)
+/// must fit in the bytes the file holds after its 20-byte header (fuzz_mat, 2026-11-28: a 91-byte file whose second
+/// name declares 1 GB, which libmatio allocates and clears before reading). "" when every variable fits.
+std::string v4_damage(const std::string& path);
+
 }  // namespace dynid::internal
