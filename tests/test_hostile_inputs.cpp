@@ -199,6 +199,14 @@ TEST(HostileInputs, MatV4NameLongerThanTheFile) {
       "the variable at byte 32: its name declares 1073741824 bytes where the file holds 39: the file is damaged");
 }
 
+TEST(HostileInputs, MatV4HeaderCheckedBeforeLibmatioOpensTheFile) {
+  // fuzz_mat (2026-11-28): a file whose first word reads as a v4 type; libmatio's Mat_Open probes it as v4 and
+  // allocates the name its header declares (1.4 GB, 5 s without ASan) before any check could run after it.
+  const std::string seed = test::CasesDir() + "/../fuzz/corpus/fuzz_mat/damaged-v4-probe-in-open.mat";
+  EXPECT_HAS(ErrorOf([&] { MatFile{seed}; }), "the variable at byte 0: its");
+  EXPECT_HAS(ErrorOf([&] { MatFile{seed}; }), "the file is damaged");
+}
+
 // A v5 file (little-endian) holding the cell array c = {[1 2]}; `data_bytes` is what the double's data tag declares
 // (16 when intact).
 std::string CellFile(std::uint32_t data_bytes) {

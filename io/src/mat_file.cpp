@@ -161,14 +161,17 @@ MatFile::MatFile(const std::string& path, const ReaderLimits& limits)
   quiet_matio();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": cannot open the file (no such file)");
+  // libmatio's Mat_Open already reads a v4 file's first header and allocates its name: v4 headers are checked
+  // first (a v5 or v7.3 file's text header is no v4 type word, so this passes them).
+  if (const std::string why = internal::v4_damage(path); !why.empty())
+    throw InputError(path + ": " + why + ": the file is damaged; save it again from MATLAB or SciPy");
   h_->mat = Mat_Open(path.c_str(), MAT_ACC_RDONLY);
   if (!h_->mat)
     throw InputError(path + ": not a MATLAB .mat file (v4, v5/v7 or v7.3)" + matio_says() +
                      "; save it from MATLAB with save(..., '-v7') or '-v7.3', or from Python with scipy.io.savemat");
   // Before libmatio lists or reads anything: it sizes allocations by the v5 tags (internal/mat_v5_check.hpp).
-  if (Mat_GetVersion(h_->mat) == MAT_FT_MAT5 || Mat_GetVersion(h_->mat) == MAT_FT_MAT4) {
-    const std::string why =
-        Mat_GetVersion(h_->mat) == MAT_FT_MAT5 ? internal::v5_damage(path) : internal::v4_damage(path);
+  if (Mat_GetVersion(h_->mat) == MAT_FT_MAT5) {
+    const std::string why = internal::v5_damage(path);
     if (!why.empty()) throw InputError(path + ": " + why + ": the file is damaged; save it again from MATLAB or SciPy");
   }
 }
