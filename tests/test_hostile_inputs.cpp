@@ -209,8 +209,8 @@ TEST(HostileInputs, MatV4HeaderCheckedBeforeLibmatioOpensTheFile) {
 }
 
 // A v5 file (little-endian) holding the cell array c = {[1 2]}; `data_bytes` is what the double's data tag declares
-// (16 when intact).
-std::string CellFile(std::uint32_t data_bytes) {
+// (16 when intact), `cells` the cell array's second dimension and `values` the double's (1 and 2 when intact).
+std::string CellFile(std::uint32_t data_bytes, std::uint32_t cells = 1, std::uint32_t values = 2) {
   std::string f = "MATLAB 5.0 MAT-file, written by dynid's tests";
   f.resize(124, ' ');
   f += std::string("\x00\x01IM", 4);
@@ -219,8 +219,8 @@ std::string CellFile(std::uint32_t data_bytes) {
   };
   // miMATRIX (14): flags (miUINT32 6, class 1 = cell), dims (miINT32 5: 1 x 1), name "c" (small miINT8 1), then
   // one cell: miMATRIX with flags (class 6 = double), dims 1 x 2, an empty name, and two doubles (miDOUBLE 9).
-  put({14, 112, 6, 8, 1, 0, 5, 8, 1, 1, 0x00010001, 'c'});
-  put({14, 64, 6, 8, 6, 0, 5, 8, 1, 2, 1, 0, 9, data_bytes});
+  put({14, 112, 6, 8, 1, 0, 5, 8, 1, cells, 0x00010001, 'c'});
+  put({14, 64, 6, 8, 6, 0, 5, 8, 1, values, 1, 0, 9, data_bytes});
   const double v[2] = {1.0, 2.0};
   f.append(reinterpret_cast<const char*>(v), 16);
   return f;
@@ -238,6 +238,22 @@ TEST(HostileInputs, MatDamagedTagInsideACell) {
   EXPECT_HAS(ErrorOf([&] { MatFile{bad}; }),
              "bad.mat: variable 'c' cell 1: its real data declare 2147483648 bytes where the array holds 16: the file "
              "is damaged");
+}
+
+TEST(HostileInputs, MatDimensionsDeclaringMoreThanTheDataHold) {
+  // fuzz_mat (CI, 2026-11-28): libmatio allocates a cell array's cells (a pointer and a header each) by its
+  // dimensions before reading any; a cell array declaring ~10^8 cells in a small file took 2 GB and 11 s to free.
+  // Each cell is an array element of 8 bytes at least; a numeric array's data hold its dimensions' values.
+  const test::ScratchDir dir("mat-dims");
+  const std::string cells = dir.path("cells.mat"), values = dir.path("values.mat");
+  std::ofstream(cells, std::ios::binary) << CellFile(16, 100000000);
+  std::ofstream(values, std::ios::binary) << CellFile(16, 1, 3);
+  EXPECT_HAS(ErrorOf([&] { MatFile{cells}; }),
+             "cells.mat: variable 'c': its dimensions 1 x 100000000 declare 100000000 cells where the array holds 72 "
+             "bytes, room for 9 at most: the file is damaged");
+  EXPECT_HAS(ErrorOf([&] { MatFile{values}; }),
+             "values.mat: variable 'c' cell 1: its dimensions 1 x 3 declare 3 values where its real data hold 16 "
+             "bytes: the file is damaged");
 }
 
 namespace fs = std::filesystem;

@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 namespace dynid::internal {
@@ -25,7 +26,8 @@ namespace {
 constexpr std::uint32_t kMiMatrix = 14, kMiCompressed = 15;
 constexpr std::uint32_t kComplexFlag = 0x0800;
 // Array classes (the low byte of the flags).
-constexpr std::uint32_t kCell = 1, kStruct = 2, kObject = 3, kChar = 4, kSparse = 5, kDouble = 6, kUint64 = 15;
+constexpr std::uint32_t kCell = 1, kStruct = 2, kObject = 3, kChar = 4, kSparse = 5, kDouble = 6, kUint64 = 15,
+                        kFunction = 16;
 constexpr int kMaxDepth = 64;
 
 // Bytes in file order, from the file itself or from a variable's inflated zlib stream.
@@ -156,7 +158,8 @@ class ArrayWalk {
     const std::uint32_t word = u32(fb, swap_);
     if (!next(&left, &dims)) return stop();
     if (over(dims, left)) return who + declares("dimensions", dims, left);
-    if (!pass(&left, dims, 0) || !next(&left, &name)) return stop();
+    Count n;
+    if (!read_dims(&left, dims, &n) || !next(&left, &name)) return stop();
     if (over(name, left)) return who + declares("name", name, left);
     std::string var;
     if (name.small) {
@@ -170,20 +173,55 @@ class ArrayWalk {
     const bool complex = word & kComplexFlag;
     std::string why;
     if (cls == kCell)
-      why = cells(&left, who, depth);
+      why = cells(&left, who, depth, n);
     else if (cls == kStruct || cls == kObject)
-      why = fields(&left, who, depth, cls == kObject);
+      why = fields(&left, who, depth, cls == kObject, n);
     else if (cls == kSparse)
-      why = parts(&left, who, complex ? 4 : 3, true);
+      why = parts(&left, who, complex ? 4 : 3, nullptr);
     else if (cls == kChar || (cls >= kDouble && cls <= kUint64))
-      why = parts(&left, who, complex ? 2 : 1, false);
-    // else: function handles and opaque objects, which dynid does not read; libmatio checks them.
+      why = parts(&left, who, complex ? 2 : 1, &n);
+    else if (cls == kFunction)  // dynid does not read them, but libmatio lists one header per element
+      why = room(who, n, n.elements, "function handles", left);
+    // else: opaque objects, which dynid does not read; libmatio checks them.
     if (!why.empty() || end_ || depth == 0) return why;  // a top-level array need not be read to its end
     if (!s_.skip(left)) return stop();
     return "";
   }
 
  private:
+  // An array's element count (its dimensions' product) and its dimensions as text ("1 x 100000000").
+  struct Count {
+    long double elements = 1;  // elements, cells or struct elements
+    std::string shape;
+  };
+  // Reads the dimensions `dims` declares (fitting in the array: checked) into their product and text.
+  bool read_dims(std::uint64_t* left, const Tag& dims, Count* n) {
+    const auto add = [&](const unsigned char* p) {
+      const std::uint32_t d = u32(p, swap_);
+      n->elements *= d;
+      n->shape += (n->shape.empty() ? "" : " x ") + std::to_string(d);
+    };
+    if (dims.small) {
+      for (std::uint64_t k = 0; k + 4 <= dims.bytes; k += 4) add(dims.inline_data.data() + k);
+      return true;
+    }
+    unsigned char d[4];
+    for (std::uint64_t k = 0; k + 4 <= dims.bytes; k += 4) {
+      if (!s_.read(d, 4)) return false;
+      add(d);
+    }
+    return pass(left, dims, dims.bytes / 4 * 4);
+  }
+  // The fewest bytes per value of a data element of MAT-file type `type` (miINT8 = 1 ... miUINT64 = 13; for
+  // miUTF8/16/32 = 16..18 per UTF-16 unit of a char array: one UTF-8 byte at least, and a surrogate pair is one
+  // 4-byte UTF-32 value); 0 for a type that sizes nothing.
+  static std::uint64_t value_bytes(std::uint32_t type) {
+    static const std::uint64_t size[] = {0, 1, 1, 2, 2, 4, 4, 4, 0, 8, 0, 0, 8, 8, 0, 0, 1, 2, 2};
+    return type < std::size(size) ? size[type] : 0;
+  }
+  static std::string count_text(long double n) {
+    return n < 1e19L ? std::to_string(static_cast<std::uint64_t>(n)) : "more than 10^19";
+  }
   // A tag declaring more data than the array holds, or a small element declaring more than the 4 bytes its tag
   // holds (libmatio reads such a count on as the element's size: fuzz_mat, 2026-11-28, a rank of 905,969,664).
   static bool over(const Tag& t, std::uint64_t left) { return t.small ? t.bytes > 4 : t.bytes > left; }
@@ -208,15 +246,22 @@ class ArrayWalk {
            (t.small ? std::string("a small data element holds at most 4") : "the array holds " + std::to_string(holds));
   }
   // `n` data elements in a row (a numeric or char array's real and imaginary data; a sparse array's ir, jc and
-  // values): each must fit. The last one's data is left to the caller (a top-level array is not read further).
-  std::string parts(std::uint64_t* left, const std::string& who, int n, bool sparse) {
+  // values): each must fit, and a numeric or char array's data (`values`: its count; null for a sparse array) must
+  // hold that many values: libmatio sizes the array by its dimensions, not by its data. The last element's data is
+  // left to the caller (a top-level array is not read further).
+  std::string parts(std::uint64_t* left, const std::string& who, int n, const Count* values) {
+    const bool sparse = values == nullptr;
     static const char* const numeric_names[] = {"real data", "imaginary data"};
     static const char* const sparse_names[] = {"sparse row indices (ir)", "sparse column pointers (jc)",
                                                "sparse values", "sparse imaginary values"};
     for (int k = 0; k < n; ++k) {
       Tag t;
       if (!next(left, &t)) return stop();
-      if (over(t, *left)) return who + declares(sparse ? sparse_names[k] : numeric_names[k], t, *left);
+      const char* what = sparse ? sparse_names[k] : numeric_names[k];
+      if (over(t, *left)) return who + declares(what, t, *left);
+      if (!sparse && values->elements * static_cast<long double>(value_bytes(t.type)) > t.bytes)
+        return who + ": its dimensions " + values->shape + " declare " + count_text(values->elements) +
+               " values where its " + what + " hold " + std::to_string(t.bytes) + " bytes";
       if (k + 1 < n && !pass(left, t, 0)) return stop();
     }
     return "";
@@ -233,14 +278,24 @@ class ArrayWalk {
     *left -= n;
     return "";
   }
-  std::string cells(std::uint64_t* left, const std::string& who, int depth) {
+  // libmatio allocates a cell array's or struct's elements (a pointer and a header each) by its dimensions before
+  // reading any (fuzz_mat, CI 2026-11-28: a cell array declaring 10^8 cells, 2 GB and 11 s to free): each element is
+  // a nested array element of 8 bytes at least, so `elements` of them must fit in what the array holds.
+  static std::string room(const std::string& who, const Count& n, long double elements, const char* what,
+                          std::uint64_t left) {
+    if (elements * 8 <= static_cast<long double>(left)) return "";
+    return who + ": its dimensions " + n.shape + " declare " + count_text(elements) + " " + what + " where the array " +
+           "holds " + std::to_string(left) + " bytes, room for " + std::to_string(left / 8) + " at most";
+  }
+  std::string cells(std::uint64_t* left, const std::string& who, int depth, const Count& n) {
+    if (std::string why = room(who, n, n.elements, "cells", *left); !why.empty()) return why;
     for (std::uint64_t k = 1; *left >= 8; ++k) {
       const std::string why = nested(left, who + " cell " + std::to_string(k), depth);
       if (!why.empty() || end_) return why;
     }
     return "";
   }
-  std::string fields(std::uint64_t* left, const std::string& who, int depth, bool object) {
+  std::string fields(std::uint64_t* left, const std::string& who, int depth, bool object, const Count& count) {
     Tag t;
     if (object) {
       if (!next(left, &t)) return stop();
@@ -253,8 +308,11 @@ class ArrayWalk {
     if (over(t, *left)) return who + declares("field names", t, *left);
     if (!pass(left, t, 0)) return stop();
     const std::uint64_t n = length ? t.bytes / length : 0;
-    for (std::uint64_t k = 1; k <= n && *left >= 8; ++k) {
-      const std::string why = nested(left, who + " field " + std::to_string(k), depth);
+    const long double elements = count.elements * static_cast<long double>(n);
+    if (std::string why = room(who, count, elements, "fields (elements x fields)", *left); !why.empty()) return why;
+    for (std::uint64_t k = 0; k < elements && *left >= 8; ++k) {  // element-major, as MAT-files store them
+      const std::string where = count.elements == 1 ? who : who + " element " + std::to_string(k / n + 1);
+      const std::string why = nested(left, where + " field " + std::to_string(k % n + 1), depth);
       if (!why.empty() || end_) return why;
     }
     return "";

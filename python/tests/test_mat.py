@@ -208,19 +208,24 @@ def test_malformed_mat_files_are_named(tmp_path, frame_mats):
 @pytest.mark.parametrize("compressed", [False, True])
 def test_every_kind_of_v5_variable_opens(tmp_path, compressed):
     """dynid checks every v5 variable's tags against its array when it opens a file (io/src/mat_v5_check.cpp):
-    intact files of every class SciPy writes (structs, nested cells, text, complex, logical, integers, empty and
-    sparse complex arrays, small elements) must open and list as they are."""
+    intact files of every class SciPy writes (structs and struct arrays, nested cells, non-ASCII text, complex,
+    logical, integers, empty and sparse complex arrays, small elements) must open and list as they are; the
+    dimensions are checked against the data too (a struct array's elements x fields, a text's characters)."""
     path = tmp_path / "all.mat"
     cell = np.empty((1, 3), dtype=object)
     cell[0, 0], cell[0, 1], cell[0, 2] = "ab", np.arange(3.0), {"x": 1.0}
     scipy.io.savemat(path, {"s": {"a": np.eye(2), "b": "text", "c": {"d": np.int8(3)}}, "c": cell,
                             "t": np.array(["1ux", "2uy"]), "z": np.array([[1 + 2j, 3j]]), "l": np.array([[True, False]]),
                             "i": np.arange(5, dtype=np.uint16), "e": np.zeros((0, 3)), "es": "",
-                            "sz": sp.csc_matrix(np.array([[0, 1j], [2.0, 0]])), "big": np.arange(200.0).reshape(10, 20)},
+                            "sz": sp.csc_matrix(np.array([[0, 1j], [2.0, 0]])), "big": np.arange(200.0).reshape(10, 20),
+                            "sa": np.array([[(1.0, "x"), (np.arange(4.0), "yy"), (3.0, {"n": 2.0})]],
+                                           dtype=[("p", object), ("q", object)]),
+                            "u": "h\u00e9llo \u2192 \U0001F600"},
                      do_compression=compressed)
     listed = {v["name"]: v for v in dynid.mat_variables(path)}
-    assert sorted(listed) == sorted(["s", "c", "t", "z", "l", "i", "e", "es", "sz", "big"])
+    assert sorted(listed) == sorted(["s", "c", "t", "z", "l", "i", "e", "es", "sz", "big", "sa", "u"])
     assert listed["s"]["type"] == "struct" and listed["c"]["type"] == "cell" and listed["sz"]["complex"]
+    assert listed["sa"]["type"] == "struct" and listed["sa"]["shape"] == (1, 3)  # a struct array: 3 elements x 2 fields
     np.testing.assert_array_equal(dynid.read_mat(path, "big"), np.arange(200.0).reshape(10, 20))
 
 

@@ -12,11 +12,14 @@ inline double max_inflated_bytes(double packed) { return 1100.0 * packed + 1e6; 
 /// Walks the top-level data elements of the v5 file `path` (inflating compressed ones) and, in each array, the
 /// tags libmatio sizes its allocations by: flags, dimensions and name; a numeric or char array's data; a sparse
 /// array's ir, jc and values; a cell's or struct's nested arrays, and a struct's field names (at most 64 levels).
-/// Returns what is wrong with the first variable where such a tag declares more bytes than its enclosing array
-/// holds, naming it ("variable 'K': its sparse column pointers (jc) declare 4294905868 bytes where the array holds
-/// 56"), or "" when every tag fits, the file ends early (libmatio reports that), or the file is not v5. libmatio
-/// allocates what a tag declares before reading it, so one damaged tag is a 4 GB allocation from a 364-byte file
-/// (fuzz_mat's seeds, both while listing a file's variables and while reading one).
+/// The dimensions, by which libmatio sizes an array, are checked too: a numeric or char array's data must hold
+/// their values, and a cell array's cells, a struct's elements x fields or a function handle's elements (nested
+/// arrays of 8 bytes at least) must fit in the array. Returns what is wrong with the first variable where a tag
+/// declares more bytes than its enclosing array holds or the dimensions more than the data, naming it ("variable 'K':
+/// its sparse column pointers (jc) declare 4294905868 bytes where the array holds 56"), or "" when every tag fits, the
+/// file ends early (libmatio reports that), or the file is not v5. libmatio allocates what a tag declares before
+/// reading it, so one damaged tag is a 4 GB allocation from a 364-byte file (fuzz_mat's seeds, both while listing a
+/// file's variables and while reading one).
 std::string v5_damage(const std::string& path);
 
 /// The same for a MATLAB v4 file: every variable's name and data (rows x cols x element size, twice when complex)
