@@ -176,8 +176,11 @@ TEST(HostileInputs, MatSmallElementArrayFlags) {
 TEST(HostileInputs, MatSmallElementDeclaringMoreThanItHolds) {
   // fuzz_mat (CI, 2026-11-28): a 317-byte v5 file whose compressed first variable has its dimensions in a small
   // element that declares 2048 bytes (a small element holds at most 4); libmatio read on to a rank of 905,969,664
-  // and allocated 3.6 GB (12 s under ASan). Refused by name.
+  // and allocated 3.6 GB (12 s under ASan). Its flags tag has type 54, which is refused first now (libmatio leaves
+  // the class empty and reads on); with its flags as miUINT32, the small element is refused by name.
   EXPECT_HAS(MatSeedError("damaged-small-element-dimensions.mat"),
+             "the variable at byte 128: its array flags are not the two 32-bit words a MAT-file holds");
+  EXPECT_HAS(MatSeedError("damaged-small-element-dimensions-uint32-flags.mat"),
              "the variable at byte 128: its dimensions declare 2048 bytes where a small data element holds at most 4: "
              "the file is damaged");
 }
@@ -206,6 +209,15 @@ TEST(HostileInputs, MatV4HeaderCheckedBeforeLibmatioOpensTheFile) {
   EXPECT_HAS(
       MatSeedError("damaged-v4-probe-in-open.mat"),
       "the variable at byte 0: its name declares 1413565728 bytes where the file holds 353: the file is damaged");
+}
+
+TEST(HostileInputs, MatArrayFlagsDeclaringMoreThanTwoWords) {
+  // fuzz_mat (2026-11-28): a 1440-byte v5 file whose third variable's flags tag declares 63 bytes. libmatio reads 8
+  // bytes of flags whatever the tag says, so it read the next words as dimensions and a cell array and allocated
+  // 3.8 GB (24 s under ASan), while the walk skipped the 63 bytes and checked something else.
+  EXPECT_HAS(MatSeedError("damaged-flags-longer-than-8-bytes.mat"),
+             "the variable at byte 1272: its array flags are not the two 32-bit words a MAT-file holds: the file is "
+             "damaged");
 }
 
 // A v5 file (little-endian) holding the cell array c = {[1 2]}; `data_bytes` is what the double's data tag declares

@@ -23,7 +23,7 @@ namespace dynid::internal {
 
 namespace {
 
-constexpr std::uint32_t kMiMatrix = 14, kMiCompressed = 15;
+constexpr std::uint32_t kMiInt32 = 5, kMiUint32 = 6, kMiMatrix = 14, kMiCompressed = 15;
 constexpr std::uint32_t kComplexFlag = 0x0800;
 // Array classes (the low byte of the flags).
 constexpr std::uint32_t kCell = 1, kStruct = 2, kObject = 3, kChar = 4, kSparse = 5, kDouble = 6, kUint64 = 15,
@@ -149,9 +149,13 @@ class ArrayWalk {
     std::uint64_t left = size;
     Tag flags, dims, name;
     if (!next(&left, &flags)) return stop();
-    // Array flags are two 32-bit words in a full tag in every MAT-file writer's output; anything else is damage that
-    // libmatio would read on into dimensions of any size (fuzz_mat, 2026-11-28: a small-element flags tag).
-    if (flags.small || flags.bytes < 8) return who + ": its array flags are not the two 32-bit words a MAT-file holds";
+    // Array flags are two 32-bit words (miUINT32, or miINT32 as some writers store them) in a full tag in every
+    // MAT-file writer's output; anything else is damage that libmatio would read on into dimensions of any size
+    // (fuzz_mat, 2026-11-28: a small-element flags tag). libmatio reads 8 bytes of flags whatever their tag
+    // declares, so a tag declaring more would put this walk and libmatio at different places (fuzz_mat: flags
+    // declaring 63 bytes; libmatio read the next words as dimensions and a cell array, and allocated 3.8 GB).
+    if (flags.small || flags.bytes != 8 || (flags.type != kMiUint32 && flags.type != kMiInt32))
+      return who + ": its array flags are not the two 32-bit words a MAT-file holds";
     if (over(flags, left)) return who + declares("array flags", flags, left);
     unsigned char fb[8];
     if (!s_.read(fb, 8) || !pass(&left, flags, 8)) return stop();
