@@ -6,6 +6,7 @@
 #include <zlib.h>
 
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -220,6 +221,21 @@ TEST(HostileInputs, MatArrayFlagsDeclaringMoreThanTwoWords) {
              "damaged");
 }
 
+TEST(HostileInputs, MatDimensionsOutOfRangeInAnEmptyArray) {
+  // fuzz_mat (2026-11-28): a 32-byte v4 file declaring a 0 x -1560281086 double array. Its data (none) fit, libmatio
+  // read the columns as 18446744072149270530, the element count (0) passed, and the matrix was resized to a
+  // negative size (an Eigen assertion). Negative v4 dimensions are refused, and so is any one dimension beyond
+  // dynid's limit even when another is 0.
+  EXPECT_HAS(MatSeedError("damaged-v4-negative-columns.mat"),
+             "the variable at byte 0: its dimensions 0 x -1560281086 are negative: the file is damaged");
+  const test::ScratchDir dir("mat-v4-empty");
+  const std::string path = dir.path("empty.mat");
+  const std::int32_t header[5] = {0, 0, 2100000000, 0, 2};  // double, little-endian; 0 x 2.1e9; real; name "x"
+  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(header), sizeof header).write("x", 2);
+  EXPECT_HAS(ErrorOf([&] { MatFile(path).matrix("x", "test"); }),
+             "empty.mat: variable 'x': a 0 x 2100000000 array is larger than dynid reads");
+}
+
 // A v5 file (little-endian) holding the cell array c = {[1 2]}; `data_bytes` is what the double's data tag declares
 // (16 when intact), `cells` the cell array's second dimension and `values` the double's (1 and 2 when intact).
 std::string CellFile(std::uint32_t data_bytes, std::uint32_t cells = 1, std::uint32_t values = 2) {
@@ -250,6 +266,22 @@ TEST(HostileInputs, MatDamagedTagInsideACell) {
   EXPECT_HAS(ErrorOf([&] { MatFile{bad}; }),
              "bad.mat: variable 'c' cell 1: its real data declare 2147483648 bytes where the array holds 16: the file "
              "is damaged");
+}
+
+TEST(HostileInputs, MatLayoutsLibmatioReadsDifferentlyAreRefused) {
+  // libmatio takes a name only from an miINT8 tag (reading on from the name's data otherwise) and dims.bytes / 4
+  // dimensions: where it would read other bytes than the tags say, the walk refuses instead of skipping.
+  const test::ScratchDir dir("mat-layouts");
+  const auto error_with = [&](std::size_t offset, std::uint32_t word) {
+    std::string f = CellFile(16);
+    std::memcpy(f.data() + offset, &word, 4);
+    const std::string path = dir.path("patched.mat");
+    std::ofstream(path, std::ios::binary) << f;
+    return ErrorOf([&] { MatFile{path}; });
+  };
+  EXPECT_HAS(error_with(152, 6), "variable at byte 128: its dimensions are not 32-bit integers (type 6, 8 bytes)");
+  EXPECT_HAS(error_with(156, 6), "variable at byte 128: its dimensions are not 32-bit integers (type 5, 6 bytes)");
+  EXPECT_HAS(error_with(216, 9), "variable 'c' cell 1: its name is not text (type 9)");
 }
 
 TEST(HostileInputs, MatDimensionsDeclaringMoreThanTheDataHold) {

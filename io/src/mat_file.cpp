@@ -73,11 +73,16 @@ std::string dims_text(const matvar_t* v) {
   return s.empty() ? "0 x 0" : s;
 }
 
-// Number of elements, or -1 when the product overflows or exceeds `max` (ReaderLimits::max_mat_elements).
+// Number of elements, or -1 when the product overflows or exceeds `max` (ReaderLimits::max_mat_elements), or one
+// dimension does: an empty array's other dimensions are sizes too (fuzz_mat, 2026-11-28: a v4 file's 0 x -1560281086
+// array read as 0 x 18446744072149270530, which a matrix cannot be resized to).
 long long numel(const matvar_t* v, long long max) {
   if (v->rank < 0 || (v->rank > 0 && !v->dims)) return -1;
   long double n = 1;
-  for (int k = 0; k < v->rank; ++k) n *= static_cast<long double>(v->dims[k]);
+  for (int k = 0; k < v->rank; ++k) {
+    if (v->dims[k] > static_cast<std::size_t>(max)) return -1;
+    n *= static_cast<long double>(v->dims[k]);
+  }
   if (n > static_cast<long double>(max)) return -1;
   return static_cast<long long>(n);
 }

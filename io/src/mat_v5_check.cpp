@@ -23,7 +23,7 @@ namespace dynid::internal {
 
 namespace {
 
-constexpr std::uint32_t kMiInt32 = 5, kMiUint32 = 6, kMiMatrix = 14, kMiCompressed = 15;
+constexpr std::uint32_t kMiInt8 = 1, kMiInt32 = 5, kMiUint32 = 6, kMiMatrix = 14, kMiCompressed = 15;
 constexpr std::uint32_t kComplexFlag = 0x0800;
 // Array classes (the low byte of the flags).
 constexpr std::uint32_t kCell = 1, kStruct = 2, kObject = 3, kChar = 4, kSparse = 5, kDouble = 6, kUint64 = 15,
@@ -162,9 +162,16 @@ class ArrayWalk {
     const std::uint32_t word = u32(fb, swap_);
     if (!next(&left, &dims)) return stop();
     if (over(dims, left)) return who + declares("dimensions", dims, left);
+    // From here on the walk must read what libmatio reads: it takes dims.bytes / 4 dimensions and a name only from
+    // an miINT8 tag (reading on from the name's data otherwise), so other layouts are refused, not skipped.
+    if (!dims.small && (dims.type != kMiInt32 || dims.bytes % 4 != 0))
+      return who + ": its dimensions are not 32-bit integers (type " + std::to_string(dims.type) + ", " +
+             std::to_string(dims.bytes) + " bytes)";
     Count n;
     if (!read_dims(&left, dims, &n) || !next(&left, &name)) return stop();
     if (over(name, left)) return who + declares("name", name, left);
+    if (!name.small && name.type != kMiInt8)
+      return who + ": its name is not text (type " + std::to_string(name.type) + ")";
     std::string var;
     if (name.small) {
       var.assign(reinterpret_cast<const char*>(name.inline_data.data()), std::min<std::uint64_t>(name.bytes, 4));
@@ -306,10 +313,17 @@ class ArrayWalk {
       if (over(t, *left)) return who + declares("class name", t, *left);
       if (!pass(left, t, 0)) return stop();
     }
-    if (!next(left, &t) || !t.small || t.bytes != 4) return stop();
-    const std::uint32_t length = u32(t.inline_data.data(), swap_);
     if (!next(left, &t)) return stop();
+    // libmatio reads the field name length as a tag and one word, whatever the tag declares, and stops at 0.
+    if (!t.small || t.type != kMiInt32 || t.bytes != 4)
+      return who + ": its field name length is not one 32-bit integer";
+    const std::uint32_t length = u32(t.inline_data.data(), swap_);
+    if (length == 0 || !next(left, &t)) return stop();
     if (over(t, *left)) return who + declares("field names", t, *left);
+    // libmatio reads as many whole names as the tag holds and then its padding, not the tag's padded size.
+    if (!t.small && (t.type != kMiInt8 || t.bytes % length != 0))
+      return who + ": its field names (" + std::to_string(t.bytes) + " bytes) are not names of " +
+             std::to_string(length) + " bytes";
     if (!pass(left, t, 0)) return stop();
     const std::uint64_t n = length ? t.bytes / length : 0;
     const long double elements = count.elements * static_cast<long double>(n);
@@ -390,6 +404,10 @@ std::string v4_damage(const std::string& path) {
     const std::uint32_t precision = (type / 10) % 10;
     const std::string where = "the variable at byte " + std::to_string(pos);
     if (precision > 5) return where + ": its type " + std::to_string(type) + " names no MAT-file v4 precision";
+    // libmatio reads rows and columns as signed 32-bit integers (fuzz_mat, 2026-11-28: 0 x -1560281086).
+    if (static_cast<std::int32_t>(rows) < 0 || static_cast<std::int32_t>(cols) < 0)
+      return where + ": its dimensions " + std::to_string(static_cast<std::int32_t>(rows)) + " x " +
+             std::to_string(static_cast<std::int32_t>(cols)) + " are negative";
     const std::uint64_t left = file_size - pos - 20;
     if (namelen > left)
       return where + ": its name declares " + std::to_string(namelen) + " bytes where the file holds " +
