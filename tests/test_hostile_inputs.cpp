@@ -221,6 +221,15 @@ TEST(HostileInputs, MatArrayFlagsDeclaringMoreThanTwoWords) {
              "damaged");
 }
 
+TEST(HostileInputs, MatV4ByteOrderReadAsLibmatioReadsIt) {
+  // fuzz_mat (2026-11-28): a 182-byte v4 file whose second type word reads as 12 only byte-swapped, with the
+  // thousands digit 0 (little-endian); libmatio reads the sizes after it little-endian, the check read them swapped
+  // and passed a name of 1,744,830,464 bytes (1.7 GB and 14 s without ASan).
+  EXPECT_HAS(
+      MatSeedError("damaged-v4-swapped-type-word.mat"),
+      "the variable at byte 21: its name declares 1744830464 bytes where the file holds 141: the file is damaged");
+}
+
 TEST(HostileInputs, MatDimensionsOutOfRangeInAnEmptyArray) {
   // fuzz_mat (2026-11-28): a 32-byte v4 file declaring a 0 x -1560281086 double array. Its data (none) fit, libmatio
   // read the columns as 18446744072149270530, the element count (0) passed, and the matrix was resized to a

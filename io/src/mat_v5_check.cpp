@@ -394,12 +394,21 @@ std::string v4_damage(const std::string& path) {
     in.seekg(static_cast<std::streamoff>(pos));
     unsigned char h[20];
     if (!in.read(reinterpret_cast<char*>(h), 20)) return "";
-    // The type word MOPT (< 5000) says the byte order: read it both ways.
-    const bool swap = u32(h, false) >= 5000;
-    const std::uint32_t type = u32(h, swap);
-    if (type >= 5000) return "";  // not a v4 header: libmatio's own checks apply
-    const std::uint64_t rows = u32(h + 4, swap), cols = u32(h + 8, swap), imag = u32(h + 12, swap),
-                        namelen = u32(h + 16, swap);
+    // As libmatio reads a v4 header (mat4.c, Mat_VarReadNextInfo4): the type word MOPT is read as a 32-bit integer
+    // and byte-swapped when it is not in 0..4052; its thousands digit M then says the byte order of the rest (0
+    // little-endian, 1 big-endian), whatever order the type word itself was in (fuzz_mat, 2026-11-28: a swapped type
+    // word with M = 0 is followed by little-endian sizes; reading them swapped missed a 1.7 GB read). Where libmatio
+    // stops listing (M > 1, O != 0, T > 2, a name of no byte), nothing after is read.
+    auto mopt = static_cast<std::int32_t>(u32(h, false));
+    if (mopt < 0 || mopt > 4052) mopt = static_cast<std::int32_t>(u32(h, true));
+    if (mopt < 0 || mopt > 4052 || mopt / 1000 > 1 || (mopt / 100) % 10 != 0 || mopt % 10 > 2) return "";
+    constexpr bool kHostBigEndian = __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__;
+    const bool swap = (mopt / 1000 == 1) != kHostBigEndian;
+    const auto type = static_cast<std::uint32_t>(mopt);
+    const std::uint64_t rows = u32(h + 4, swap), cols = u32(h + 8, swap), imag = u32(h + 12, false);
+    const auto name_length = static_cast<std::int32_t>(u32(h + 16, swap));
+    if (name_length < 1) return "";
+    const auto namelen = static_cast<std::uint64_t>(name_length);
     static const std::uint64_t bytes_of[] = {8, 4, 4, 2, 2, 1};  // P: double, single, int32, int16, uint16, uint8
     const std::uint32_t precision = (type / 10) % 10;
     const std::string where = "the variable at byte " + std::to_string(pos);
