@@ -245,22 +245,29 @@ TEST(HostileInputs, MatDimensionsOutOfRangeInAnEmptyArray) {
              "empty.mat: variable 'x': a 0 x 2100000000 array is larger than dynid reads");
 }
 
-// A v5 file (little-endian) holding the cell array c = {[1 2]}; `data_bytes` is what the double's data tag declares
-// (16 when intact), `cells` the cell array's second dimension and `values` the double's (1 and 2 when intact).
-std::string CellFile(std::uint32_t data_bytes, std::uint32_t cells = 1, std::uint32_t values = 2) {
+// A v5 file (little-endian): the 128-byte header, then `words` (32-bit, in file order) and `data` after them.
+std::string V5File(std::initializer_list<std::uint32_t> words, const std::string& data = "") {
   std::string f = "MATLAB 5.0 MAT-file, written by dynid's tests";
   f.resize(124, ' ');
   f += std::string("\x00\x01IM", 4);
-  auto put = [&](std::initializer_list<std::uint32_t> words) {
-    for (std::uint32_t w : words) f.append(reinterpret_cast<const char*>(&w), 4);
-  };
+  for (std::uint32_t w : words) f.append(reinterpret_cast<const char*>(&w), 4);
+  return f + data;
+}
+
+// The 16 bytes of the doubles 1 and 2.
+std::string OneTwo() {
+  const double v[2] = {1.0, 2.0};
+  return std::string(reinterpret_cast<const char*>(v), 16);
+}
+
+// A v5 file holding the cell array c = {[1 2]}; `data_bytes` is what the double's data tag declares (16 when
+// intact), `cells` the cell array's second dimension and `values` the double's (1 and 2 when intact).
+std::string CellFile(std::uint32_t data_bytes, std::uint32_t cells = 1, std::uint32_t values = 2) {
   // miMATRIX (14): flags (miUINT32 6, class 1 = cell), dims (miINT32 5: 1 x 1), name "c" (small miINT8 1), then
   // one cell: miMATRIX with flags (class 6 = double), dims 1 x 2, an empty name, and two doubles (miDOUBLE 9).
-  put({14, 112, 6, 8, 1, 0, 5, 8, 1, cells, 0x00010001, 'c'});
-  put({14, 64, 6, 8, 6, 0, 5, 8, 1, values, 1, 0, 9, data_bytes});
-  const double v[2] = {1.0, 2.0};
-  f.append(reinterpret_cast<const char*>(v), 16);
-  return f;
+  return V5File({14, 112, 6, 8, 1, 0, 5, 8, 1, cells,  0x00010001, 'c',  //
+                 14, 64,  6, 8, 6, 0, 5, 8, 1, values, 1,          0,   9, data_bytes},
+                OneTwo());
 }
 
 TEST(HostileInputs, MatDamagedTagInsideACell) {
@@ -275,6 +282,20 @@ TEST(HostileInputs, MatDamagedTagInsideACell) {
   EXPECT_HAS(ErrorOf([&] { MatFile{bad}; }),
              "bad.mat: variable 'c' cell 1: its real data declare 2147483648 bytes where the array holds 16: the file "
              "is damaged");
+}
+
+TEST(HostileInputs, MatEmptyCellDoesNotEndTheCheck) {
+  // libmatio takes a cell whose tag's second word is 0 as empty, whatever its type, and reads the next cell; the walk
+  // used to stop at such a tag and leave the next cells unchecked. c = {[], [1 2]} with the second cell's data tag
+  // declaring 2 GB: refused at cell 2.
+  const test::ScratchDir dir("mat-empty-cell");
+  const std::string path = dir.path("empty-cell.mat");
+  std::ofstream(path, std::ios::binary) << V5File({14, 120, 6, 8, 1, 0, 5, 8, 1, 2, 0x00010001, 'c',  //
+                                                   5,  0,                                             // empty cell
+                                                   14, 64,  6, 8, 6, 0, 5, 8, 1, 2, 1,          0,   9, 0x80000000u},
+                                                  OneTwo());
+  EXPECT_HAS(ErrorOf([&] { MatFile{path}; }),
+             "variable 'c' cell 2: its real data declare 2147483648 bytes where the array holds 16");
 }
 
 TEST(HostileInputs, MatLayoutsLibmatioReadsDifferentlyAreRefused) {

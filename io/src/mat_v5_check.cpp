@@ -279,7 +279,11 @@ class ArrayWalk {
   }
   std::string nested(std::uint64_t* left, const std::string& who, int depth) {
     Tag t;
-    if (!next(left, &t) || t.small || t.type != kMiMatrix) return stop();
+    if (!next(left, &t)) return stop();
+    // libmatio takes any tag whose second word is 0 as an empty element and reads on (a walk that stopped there
+    // would leave the next elements unchecked); any other tag that is not miMATRIX ends its reading.
+    if ((t.small ? u32(t.inline_data.data(), swap_) : t.bytes) == 0) return "";
+    if (t.small || t.type != kMiMatrix) return stop();
     if (over(t, *left))
       return who + ": its array element declares " + std::to_string(t.bytes) +
              " bytes where the enclosing array holds " + std::to_string(*left);
