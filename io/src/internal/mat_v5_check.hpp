@@ -19,12 +19,16 @@ inline double max_inflated_bytes(double packed) { return 1100.0 * packed + 1e6; 
 /// its sparse column pointers (jc) declare 4294905868 bytes where the array holds 56"), or "" when every tag fits, the
 /// file ends early (libmatio reports that), or the file is not v5. libmatio allocates what a tag declares before
 /// reading it, so one damaged tag is a 4 GB allocation from a 364-byte file (fuzz_mat's seeds, both while listing a
-/// file's variables and while reading one).
+/// file's variables and while reading one). The walk reads the tags as libmatio reads them (mat5.c): a layout where
+/// libmatio would read other bytes than the tags say (flags not 8 bytes of miUINT32, a full name tag not miINT8,
+/// dimensions or field names not whole values) is refused rather than skipped, so that both read the same bytes.
 std::string v5_damage(const std::string& path);
 
-/// The same for a MATLAB v4 file: every variable's name and data (rows x cols x element size, twice when complex)
-/// must fit in the bytes the file holds after its 20-byte header (fuzz_mat, 2026-11-28: a 91-byte file whose second
-/// name declares 1 GB, which libmatio allocates and clears before reading). "" when every variable fits.
+/// The same for a MATLAB v4 file, its headers read as libmatio's Mat_VarReadNextInfo4 reads them (byte order from
+/// the type word's thousands digit; signed sizes): no dimension may be negative, and every variable's name and data
+/// (rows x cols x element size, twice when complex) must fit in the bytes the file holds after its 20-byte header
+/// (fuzz_mat, 2026-11-28: a 91-byte file whose second name declares 1 GB, which libmatio allocates and clears before
+/// reading). "" when every variable fits.
 std::string v4_damage(const std::string& path);
 
 }  // namespace dynid::internal
