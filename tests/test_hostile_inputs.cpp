@@ -298,6 +298,19 @@ TEST(HostileInputs, MatEmptyCellDoesNotEndTheCheck) {
              "variable 'c' cell 2: its real data declare 2147483648 bytes where the array holds 16");
 }
 
+TEST(HostileInputs, MatTextOfManyEmptyRowsCountsAgainstTheLimit) {
+  // fuzz_mat (2026-11-28): a cell holding a char array of 10^8 rows and no columns; its element count is 0, and
+  // reading it as text made 10^8 empty strings (3.2 GB). Each row counts as one element at least.
+  const test::ScratchDir dir("mat-text-rows");
+  const std::string path = dir.path("rows.mat");
+  std::ofstream(path, std::ios::binary) << V5File({14, 96, 6, 8, 1, 0, 5, 8, 1,       1, 0x00010001, 'c',  //
+                                                   14, 48, 6, 8, 4, 0, 5, 8, 3000000, 0, 1,          0,   4, 0});
+  ReaderLimits limits;
+  limits.max_mat_elements = 1000000;
+  EXPECT_HAS(ErrorOf([&] { MatFile(path, limits).strings("c", "channel names"); }),
+             "cell 1 is a 3000000 x 0 char array, larger than dynid reads");
+}
+
 TEST(HostileInputs, MatLayoutsLibmatioReadsDifferentlyAreRefused) {
   // libmatio takes a name only from an miINT8 tag (reading on from the name's data otherwise) and dims.bytes / 4
   // dimensions: where it would read other bytes than the tags say, the walk refuses instead of skipping.

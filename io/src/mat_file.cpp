@@ -289,6 +289,12 @@ std::vector<std::string> strings_of(const matvar_t* v, const std::string& w, lon
   if (v->class_type == MAT_C_CHAR) {
     if (v->rank != 2) throw InputError(w + " is a " + dims_text(v) + " char array; one string per row is needed");
     const std::size_t rows = v->dims[0], cols = v->dims[1];
+    // Each row is a string even when the text has no columns: a row counts as one element at least (fuzz_mat,
+    // 2026-11-28: a cell holding a 10^8 x 0 char array, 3.2 GB of empty strings).
+    if (numel(v, max) < 0 || static_cast<long double>(rows) * static_cast<long double>(std::max<std::size_t>(cols, 1)) >
+                                 static_cast<long double>(max))
+      throw InputError(w + " is a " + dims_text(v) + " char array, larger than dynid reads (" +
+                       limit_text(static_cast<double>(max)) + " elements)");
     const int ts = v->data_size > 0 ? v->data_size : 1;
     if (rows * cols > 0 && (!v->data || v->nbytes < rows * cols * static_cast<std::size_t>(ts)))
       throw InputError(w + ": its text is incomplete");
