@@ -298,6 +298,33 @@ TEST(HostileInputs, MatEmptyCellDoesNotEndTheCheck) {
              "variable 'c' cell 2: its real data declare 2147483648 bytes where the array holds 16");
 }
 
+TEST(HostileInputs, MatCellArrayReadToItsDeclaredCount) {
+  // fuzz_mat (2026-11-28): an empty cell array followed by 8 more bytes inside its element. libmatio reads as many
+  // cells as the dimensions declare and goes on to the next cell; the walk read the 8 bytes as a cell, stopped there
+  // and left the next cell (dimensions declaring 3.5 GB, a 7 GB allocation) unchecked. c = {{}, [1 2]} with the
+  // second cell's data tag declaring 2 GB: refused at cell 2.
+  const test::ScratchDir dir("mat-cell-count");
+  const std::string path = dir.path("cells.mat");
+  std::ofstream(path, std::ios::binary) << V5File(
+      {14, 168, 6, 8, 1, 0, 5, 8, 1, 2, 0x00010001, 'c',  //
+       14, 48,  6, 8, 1, 0, 5, 8, 0, 0, 1,          0,   0x00030010, 'x',
+       14, 64,  6, 8, 6, 0, 5, 8, 1, 2, 1,          0,   9,          0x80000000u},
+      OneTwo());
+  EXPECT_HAS(ErrorOf([&] { MatFile{path}; }),
+             "variable 'c' cell 2: its real data declare 2147483648 bytes where the array holds 16");
+}
+
+TEST(HostileInputs, MatFunctionHandleRefusedByName) {
+  // fuzz_mat (2026-11-28): libmatio 1.5.23 reads a function handle's elements from the variables after it and, on a
+  // damaged one, frees them with free(), leaking their contents. dynid reads no function handles: refused by name.
+  const test::ScratchDir dir("mat-function");
+  const std::string path = dir.path("handle.mat");
+  std::ofstream(path, std::ios::binary) << V5File({14, 40, 6, 8, 16, 0, 5, 8, 1, 1, 0x00010001, 'f'});
+  EXPECT_HAS(ErrorOf([&] { MatFile{path}; }),
+             "variable 'f' is a MATLAB function handle (array class 16), which dynid does not read; save the file "
+             "without it");
+}
+
 TEST(HostileInputs, MatTextOfManyEmptyRowsCountsAgainstTheLimit) {
   // fuzz_mat (2026-11-28): a cell holding a char array of 10^8 rows and no columns; its element count is 0, and
   // reading it as text made 10^8 empty strings (3.2 GB). Each row counts as one element at least.

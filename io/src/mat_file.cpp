@@ -176,8 +176,12 @@ MatFile::MatFile(const std::string& path, const ReaderLimits& limits)
                      "; save it from MATLAB with save(..., '-v7') or '-v7.3', or from Python with scipy.io.savemat");
   // Before libmatio lists or reads anything: it sizes allocations by the v5 tags (internal/mat_v5_check.hpp).
   if (Mat_GetVersion(h_->mat) == MAT_FT_MAT5) {
-    const std::string why = internal::v5_damage(path);
-    if (!why.empty()) throw InputError(path + ": " + why + ": the file is damaged; save it again from MATLAB or SciPy");
+    bool unsupported = false;
+    const std::string why = internal::v5_damage(path, &unsupported);
+    if (!why.empty())
+      throw InputError(
+          path + ": " + why +
+          (unsupported ? "; save the file without it" : ": the file is damaged; save it again from MATLAB or SciPy"));
   }
 }
 

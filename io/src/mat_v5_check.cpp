@@ -135,11 +135,15 @@ bool read_tag(Source& s, bool swap, Tag* t) {
 class ArrayWalk {
  public:
   ArrayWalk(Source& s, bool swap) : s_(s), swap_(swap) {}
+  // Whether the last refusal was of something dynid does not read rather than of damage.
+  bool refused_unsupported() const { return unsupported_; }
   // The miMATRIX element `who` of `size` bytes, its tag read; consumes all of them unless the walk ended. A
   // top-level array (depth 0) is named by its variable name once that is read.
   std::string array(std::uint64_t size, std::string who, int depth) {
-    if (depth > kMaxDepth)
+    if (depth > kMaxDepth) {
+      unsupported();
       return who + " is nested more than " + std::to_string(kMaxDepth) + " levels deep (dynid reads at most that)";
+    }
     // Flags (16 bytes), dimensions (16 at least) and a name (8 at least): a smaller array element is damage that
     // libmatio reads past, into whatever follows (fuzz_mat, 2026-11-28: a top-level array of 0 bytes, then
     // dimensions declaring 4 GB). A nested array of 0 bytes is an empty cell or field.
@@ -191,8 +195,12 @@ class ArrayWalk {
       why = parts(&left, who, complex ? 4 : 3, nullptr);
     else if (cls == kChar || (cls >= kDouble && cls <= kUint64))
       why = parts(&left, who, complex ? 2 : 1, &n);
-    else if (cls == kFunction)  // dynid does not read them, but libmatio lists one header per element
-      why = room(who, n, n.elements, "function handles", left);
+    else if (cls == kFunction) {
+      // libmatio 1.5.23 reads a function handle's elements as the variables that follow it, and on a damaged one
+      // frees them with free(), leaking their contents (fuzz_mat, 2026-11-28); dynid reads no function handles.
+      unsupported();
+      why = who + " is a MATLAB function handle (array class 16), which dynid does not read";
+    }
     // else: opaque objects, which dynid does not read; libmatio checks them.
     if (!why.empty() || end_ || depth == 0) return why;  // a top-level array need not be read to its end
     if (!s_.skip(left)) return stop();
@@ -304,8 +312,14 @@ class ArrayWalk {
   }
   std::string cells(std::uint64_t* left, const std::string& who, int depth, const Count& n) {
     if (std::string why = room(who, n, n.elements, "cells", *left); !why.empty()) return why;
-    for (std::uint64_t k = 1; *left >= 8; ++k) {
-      const std::string why = nested(left, who + " cell " + std::to_string(k), depth);
+    // libmatio reads as many cells as the dimensions declare, then goes on after the array: so does the walk (fuzz_mat,
+    // 2026-11-28: an empty cell array followed by 8 bytes the walk read as a cell and stopped at, while libmatio went
+    // on to the next cell and a 7 GB rank).
+    for (std::uint64_t k = 0; k < n.elements; ++k) {
+      if (*left < 8)
+        return who + ": its dimensions " + n.shape + " declare " + count_text(n.elements) +
+               " cells where the array holds " + std::to_string(k);
+      const std::string why = nested(left, who + " cell " + std::to_string(k + 1), depth);
       if (!why.empty() || end_) return why;
     }
     return "";
@@ -332,7 +346,10 @@ class ArrayWalk {
     const std::uint64_t n = length ? t.bytes / length : 0;
     const long double elements = count.elements * static_cast<long double>(n);
     if (std::string why = room(who, count, elements, "fields (elements x fields)", *left); !why.empty()) return why;
-    for (std::uint64_t k = 0; k < elements && *left >= 8; ++k) {  // element-major, as MAT-files store them
+    for (std::uint64_t k = 0; k < elements; ++k) {  // element-major, as MAT-files store them
+      if (*left < 8)
+        return who + ": its dimensions " + count.shape + " and " + std::to_string(n) + " fields declare " +
+               count_text(elements) + " fields where the array holds " + std::to_string(k);
       const std::string where = count.elements == 1 ? who : who + " element " + std::to_string(k / n + 1);
       const std::string why = nested(left, where + " field " + std::to_string(k % n + 1), depth);
       if (!why.empty() || end_) return why;
@@ -340,14 +357,16 @@ class ArrayWalk {
     return "";
   }
 
+  void unsupported() { unsupported_ = true; }
   Source& s_;
   bool swap_;
   bool end_ = false;
+  bool unsupported_ = false;
 };
 
 }  // namespace
 
-std::string v5_damage(const std::string& path) {
+std::string v5_damage(const std::string& path, bool* unsupported) {
   std::ifstream in(path, std::ios::binary);
   unsigned char header[128];
   if (!in.read(reinterpret_cast<char*>(header), 128)) return "";
@@ -370,18 +389,25 @@ std::string v5_damage(const std::string& path) {
     const std::uint64_t body = file_size - pos - 8;
     const std::string where = "the variable at byte " + std::to_string(pos);
     std::string why;
+    bool refused_unsupported = false;
     if (t.type == kMiMatrix) {
-      why = ArrayWalk(file, swap).array(std::min(t.bytes, body), where, 0);
+      ArrayWalk walk(file, swap);
+      why = walk.array(std::min(t.bytes, body), where, 0);
+      refused_unsupported = walk.refused_unsupported();
     } else if (t.type == kMiCompressed) {
       // The inflated array cannot exceed zlib's largest ratio (about 1032:1) times the compressed bytes.
       const std::uint64_t packed = std::min(t.bytes, body);
       ZlibSource z(in, packed);
       Tag inner;
-      if (read_tag(z, swap, &inner) && !inner.small && inner.type == kMiMatrix)
-        why = ArrayWalk(z, swap).array(
+      if (read_tag(z, swap, &inner) && !inner.small && inner.type == kMiMatrix) {
+        ArrayWalk walk(z, swap);
+        why = walk.array(
             std::min(inner.bytes, static_cast<std::uint64_t>(max_inflated_bytes(static_cast<double>(packed)))), where,
             0);
+        refused_unsupported = walk.refused_unsupported();
+      }
     }
+    if (unsupported) *unsupported = refused_unsupported;
     if (!why.empty()) return why;
     pos += 8 + (t.type == kMiCompressed ? t.bytes : t.stored);
   }
