@@ -314,6 +314,22 @@ TEST(HostileInputs, MatCellArrayReadToItsDeclaredCount) {
              "variable 'c' cell 2: its real data declare 2147483648 bytes where the array holds 16");
 }
 
+TEST(HostileInputs, MatCellCountCheckedWhenTheStreamBreaksAfterTheDimensions) {
+  // fuzz_mat (2026-11-28): a compressed cell array whose zlib checksum fails right after its dimensions (1 x
+  // 1650614786); the walk dropped the bytes inflated with the error and stopped, libmatio used them and allocated
+  // 1.65e9 cells. The inflated bytes count, and a cell array's dimensions are checked before its name.
+  EXPECT_HAS(MatSeedError("damaged-cell-count-in-broken-stream.mat"),
+             "the variable at byte 250: its dimensions 1 x 1650614786 declare 1650614786 cells where the array holds "
+             "112 bytes, room for 14 at most: the file is damaged");
+}
+
+TEST(HostileInputs, MatNextVariableWhereLibmatioReadsIt) {
+  // fuzz_mat (2026-11-28): a first variable declaring 1073 bytes; libmatio reads the next one 8 + 1073 bytes on, the
+  // walk went on at the padded end (1080) and missed the function handle libmatio found there.
+  EXPECT_HAS(MatSeedError("damaged-unpadded-variable-size.mat"),
+             "variable 'channels' is a MATLAB function handle (array class 16), which dynid does not read");
+}
+
 TEST(HostileInputs, MatFunctionHandleRefusedByName) {
   // fuzz_mat (2026-11-28): libmatio 1.5.23 reads a function handle's elements from the variables after it and, on a
   // damaged one, frees them with free(), leaking their contents. dynid reads no function handles: refused by name.
@@ -363,8 +379,8 @@ TEST(HostileInputs, MatDimensionsDeclaringMoreThanTheDataHold) {
   std::ofstream(cells, std::ios::binary) << CellFile(16, 100000000);
   std::ofstream(values, std::ios::binary) << CellFile(16, 1, 3);
   EXPECT_HAS(ErrorOf([&] { MatFile{cells}; }),
-             "cells.mat: variable 'c': its dimensions 1 x 100000000 declare 100000000 cells where the array holds 72 "
-             "bytes, room for 9 at most: the file is damaged");
+             "cells.mat: the variable at byte 128: its dimensions 1 x 100000000 declare 100000000 cells where the "
+             "array holds 72 bytes, room for 9 at most: the file is damaged");  // checked before the name is read
   EXPECT_HAS(ErrorOf([&] { MatFile{values}; }),
              "values.mat: variable 'c' cell 1: its dimensions 1 x 3 declare 3 values where its real data hold 16 "
              "bytes: the file is damaged");

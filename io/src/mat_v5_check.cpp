@@ -82,11 +82,15 @@ class ZlibSource : public Source {
       z_.next_out = dst ? dst : scratch.data();
       z_.avail_out = static_cast<uInt>(want);
       const int rc = inflate(&z_, Z_NO_FLUSH);
-      if (rc != Z_OK && rc != Z_STREAM_END) return false;
       const std::uint64_t got = want - z_.avail_out;
       n -= got;
       if (dst) dst += got;
-      if (rc == Z_STREAM_END) ended_ = true;
+      // The bytes inflated before an error count, as libmatio uses them (fuzz_mat, 2026-11-28: a stream whose
+      // checksum fails right after a cell array's dimensions; the walk lost them and libmatio allocated 1.65e9 cells).
+      if (rc == Z_STREAM_END || (rc != Z_OK && got > 0))
+        ended_ = true;
+      else if (rc != Z_OK)
+        return false;
     }
     return true;
   }
@@ -172,7 +176,13 @@ class ArrayWalk {
       return who + ": its dimensions are not 32-bit integers (type " + std::to_string(dims.type) + ", " +
              std::to_string(dims.bytes) + " bytes)";
     Count n;
-    if (!read_dims(&left, dims, &n) || !next(&left, &name)) return stop();
+    if (!read_dims(&left, dims, &n)) return stop();
+    const std::uint32_t cls = word & 0xFF;
+    // libmatio sizes a cell array by its dimensions even when what follows them is unreadable: checked before the
+    // name (a name tag of 8 bytes at least comes first).
+    if (cls == kCell && left >= 8)
+      if (std::string why = room(who, n, n.elements, "cells", left - 8); !why.empty()) return why;
+    if (!next(&left, &name)) return stop();
     if (over(name, left)) return who + declares("name", name, left);
     if (!name.small && name.type != kMiInt8)
       return who + ": its name is not text (type " + std::to_string(name.type) + ")";
@@ -184,7 +194,6 @@ class ArrayWalk {
       if (!s_.read(var.data(), var.size()) || !pass(&left, name, var.size())) return stop();
     }
     if (depth == 0) who = "variable '" + var + "'";
-    const std::uint32_t cls = word & 0xFF;
     const bool complex = word & kComplexFlag;
     std::string why;
     if (cls == kCell)
@@ -409,7 +418,9 @@ std::string v5_damage(const std::string& path, bool* unsupported) {
     }
     if (unsupported) *unsupported = refused_unsupported;
     if (!why.empty()) return why;
-    pos += 8 + (t.type == kMiCompressed ? t.bytes : t.stored);
+    // libmatio goes on 8 + the declared bytes after a variable, padded or not (fuzz_mat, 2026-11-28: a variable of
+    // 1073 bytes; the walk went on at its padded end, libmatio 7 bytes earlier, into a function handle).
+    pos += 8 + t.bytes;
   }
   return "";
 }
