@@ -330,6 +330,14 @@ TEST(HostileInputs, MatNextVariableWhereLibmatioReadsIt) {
              "variable 'channels' is a MATLAB function handle (array class 16), which dynid does not read");
 }
 
+TEST(HostileInputs, MatArrayCutInsideItsHeader) {
+  // fuzz_mat (2026-11-28): a compressed variable whose zlib stream ends after half of its second dimension; libmatio
+  // read the rest from its buffer (1 x 1650614786 cells, a 13 GB allocation) where the walk had stopped.
+  EXPECT_HAS(MatSeedError("damaged-stream-cut-inside-dimensions.mat"),
+             "the variable at byte 250: its data end inside its flags, dimensions and name (the file is cut short, or "
+             "its compressed data are damaged)");
+}
+
 TEST(HostileInputs, MatFunctionHandleRefusedByName) {
   // fuzz_mat (2026-11-28): libmatio 1.5.23 reads a function handle's elements from the variables after it and, on a
   // damaged one, frees them with free(), leaking their contents. dynid reads no function handles: refused by name.
