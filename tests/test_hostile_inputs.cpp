@@ -156,6 +156,14 @@ std::string MatSeedError(const std::string& name) {
   return ErrorOf([&] { MatFile{seed}; });
 }
 
+// The error opening a .mat file named `name` that holds `bytes` (written to a scratch folder).
+std::string MatBytesError(const std::string& bytes, const std::string& name = "damaged.mat") {
+  const test::ScratchDir dir("mat-bytes");
+  const std::string path = dir.path(name);
+  std::ofstream(path, std::ios::binary) << bytes;
+  return ErrorOf([&] { MatFile{path}; });
+}
+
 TEST(HostileInputs, MatDamagedHeaderWhileListing) {
   // fuzz_mat (CI, 2026-11-28): a 497-byte v5 file whose double array declares 1633943556 bytes of dimensions;
   // libmatio's Mat_VarReadNextInfo allocated them while dynid listed the variables for an error message (26.6 s
@@ -288,13 +296,10 @@ TEST(HostileInputs, MatEmptyCellDoesNotEndTheCheck) {
   // libmatio takes a cell whose tag's second word is 0 as empty, whatever its type, and reads the next cell; the walk
   // used to stop at such a tag and leave the next cells unchecked. c = {[], [1 2]} with the second cell's data tag
   // declaring 2 GB: refused at cell 2.
-  const test::ScratchDir dir("mat-empty-cell");
-  const std::string path = dir.path("empty-cell.mat");
-  std::ofstream(path, std::ios::binary) << V5File({14, 120, 6, 8, 1, 0, 5, 8, 1, 2, 0x00010001, 'c',  //
-                                                   5,  0,                                             // empty cell
-                                                   14, 64,  6, 8, 6, 0, 5, 8, 1, 2, 1,          0,   9, 0x80000000u},
-                                                  OneTwo());
-  EXPECT_HAS(ErrorOf([&] { MatFile{path}; }),
+  EXPECT_HAS(MatBytesError(V5File({14, 120, 6, 8, 1, 0, 5, 8, 1, 2, 0x00010001, 'c',  //
+                                   5,  0,                                             // empty cell
+                                   14, 64,  6, 8, 6, 0, 5, 8, 1, 2, 1,          0,   9, 0x80000000u},
+                                  OneTwo())),
              "variable 'c' cell 2: its real data declare 2147483648 bytes where the array holds 16");
 }
 
@@ -303,14 +308,10 @@ TEST(HostileInputs, MatCellArrayReadToItsDeclaredCount) {
   // cells as the dimensions declare and goes on to the next cell; the walk read the 8 bytes as a cell, stopped there
   // and left the next cell (dimensions declaring 3.5 GB, a 7 GB allocation) unchecked. c = {{}, [1 2]} with the
   // second cell's data tag declaring 2 GB: refused at cell 2.
-  const test::ScratchDir dir("mat-cell-count");
-  const std::string path = dir.path("cells.mat");
-  std::ofstream(path, std::ios::binary) << V5File(
-      {14, 168, 6, 8, 1, 0, 5, 8, 1, 2, 0x00010001, 'c',  //
-       14, 48,  6, 8, 1, 0, 5, 8, 0, 0, 1,          0,   0x00030010, 'x',
-       14, 64,  6, 8, 6, 0, 5, 8, 1, 2, 1,          0,   9,          0x80000000u},
-      OneTwo());
-  EXPECT_HAS(ErrorOf([&] { MatFile{path}; }),
+  EXPECT_HAS(MatBytesError(V5File({14, 168, 6, 8, 1, 0, 5, 8, 1, 2, 0x00010001, 'c',  //
+                                   14, 48,  6, 8, 1, 0, 5, 8, 0, 0, 1,          0,   0x00030010, 'x',
+                                   14, 64,  6, 8, 6, 0, 5, 8, 1, 2, 1,          0,   9,          0x80000000u},
+                                  OneTwo())),
              "variable 'c' cell 2: its real data declare 2147483648 bytes where the array holds 16");
 }
 
@@ -341,10 +342,7 @@ TEST(HostileInputs, MatArrayCutInsideItsHeader) {
 TEST(HostileInputs, MatFunctionHandleRefusedByName) {
   // fuzz_mat (2026-11-28): libmatio 1.5.23 reads a function handle's elements from the variables after it and, on a
   // damaged one, frees them with free(), leaking their contents. dynid reads no function handles: refused by name.
-  const test::ScratchDir dir("mat-function");
-  const std::string path = dir.path("handle.mat");
-  std::ofstream(path, std::ios::binary) << V5File({14, 40, 6, 8, 16, 0, 5, 8, 1, 1, 0x00010001, 'f'});
-  EXPECT_HAS(ErrorOf([&] { MatFile{path}; }),
+  EXPECT_HAS(MatBytesError(V5File({14, 40, 6, 8, 16, 0, 5, 8, 1, 1, 0x00010001, 'f'})),
              "variable 'f' is a MATLAB function handle (array class 16), which dynid does not read; save the file "
              "without it");
 }
@@ -365,13 +363,10 @@ TEST(HostileInputs, MatTextOfManyEmptyRowsCountsAgainstTheLimit) {
 TEST(HostileInputs, MatLayoutsLibmatioReadsDifferentlyAreRefused) {
   // libmatio takes a name only from an miINT8 tag (reading on from the name's data otherwise) and dims.bytes / 4
   // dimensions: where it would read other bytes than the tags say, the walk refuses instead of skipping.
-  const test::ScratchDir dir("mat-layouts");
-  const auto error_with = [&](std::size_t offset, std::uint32_t word) {
+  const auto error_with = [](std::size_t offset, std::uint32_t word) {
     std::string f = CellFile(16);
     std::memcpy(f.data() + offset, &word, 4);
-    const std::string path = dir.path("patched.mat");
-    std::ofstream(path, std::ios::binary) << f;
-    return ErrorOf([&] { MatFile{path}; });
+    return MatBytesError(f);
   };
   EXPECT_HAS(error_with(152, 6), "variable at byte 128: its dimensions are not 32-bit integers (type 6, 8 bytes)");
   EXPECT_HAS(error_with(156, 6), "variable at byte 128: its dimensions are not 32-bit integers (type 5, 6 bytes)");
@@ -382,14 +377,10 @@ TEST(HostileInputs, MatDimensionsDeclaringMoreThanTheDataHold) {
   // fuzz_mat (CI, 2026-11-28): libmatio allocates a cell array's cells (a pointer and a header each) by its
   // dimensions before reading any; a cell array declaring ~10^8 cells in a small file took 2 GB and 11 s to free.
   // Each cell is an array element of 8 bytes at least; a numeric array's data hold its dimensions' values.
-  const test::ScratchDir dir("mat-dims");
-  const std::string cells = dir.path("cells.mat"), values = dir.path("values.mat");
-  std::ofstream(cells, std::ios::binary) << CellFile(16, 100000000);
-  std::ofstream(values, std::ios::binary) << CellFile(16, 1, 3);
-  EXPECT_HAS(ErrorOf([&] { MatFile{cells}; }),
+  EXPECT_HAS(MatBytesError(CellFile(16, 100000000), "cells.mat"),
              "cells.mat: the variable at byte 128: its dimensions 1 x 100000000 declare 100000000 cells where the "
              "array holds 72 bytes, room for 9 at most: the file is damaged");  // checked before the name is read
-  EXPECT_HAS(ErrorOf([&] { MatFile{values}; }),
+  EXPECT_HAS(MatBytesError(CellFile(16, 1, 3), "values.mat"),
              "values.mat: variable 'c' cell 1: its dimensions 1 x 3 declare 3 values where its real data hold 16 "
              "bytes: the file is damaged");
 }

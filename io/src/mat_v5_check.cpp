@@ -406,22 +406,20 @@ std::string v5_damage(const std::string& path, bool* unsupported) {
     const std::string where = "the variable at byte " + std::to_string(pos);
     std::string why;
     bool refused_unsupported = false;
+    const auto walk = [&](Source& source, std::uint64_t size) {
+      ArrayWalk w(source, swap);
+      why = w.array(size, where, 0);
+      refused_unsupported = w.refused_unsupported();
+    };
     if (t.type == kMiMatrix) {
-      ArrayWalk walk(file, swap);
-      why = walk.array(std::min(t.bytes, body), where, 0);
-      refused_unsupported = walk.refused_unsupported();
+      walk(file, std::min(t.bytes, body));
     } else if (t.type == kMiCompressed) {
       // The inflated array cannot exceed zlib's largest ratio (about 1032:1) times the compressed bytes.
       const std::uint64_t packed = std::min(t.bytes, body);
       ZlibSource z(in, packed);
       Tag inner;
-      if (read_tag(z, swap, &inner) && !inner.small && inner.type == kMiMatrix) {
-        ArrayWalk walk(z, swap);
-        why = walk.array(
-            std::min(inner.bytes, static_cast<std::uint64_t>(max_inflated_bytes(static_cast<double>(packed)))), where,
-            0);
-        refused_unsupported = walk.refused_unsupported();
-      }
+      if (read_tag(z, swap, &inner) && !inner.small && inner.type == kMiMatrix)
+        walk(z, std::min(inner.bytes, static_cast<std::uint64_t>(max_inflated_bytes(static_cast<double>(packed)))));
     }
     if (unsupported) *unsupported = refused_unsupported;
     if (!why.empty()) return why;
