@@ -1,4 +1,5 @@
-// MATLAB .mat files through libmatio (dynid/io/mat_file.hpp).
+// MATLAB .mat files (dynid/io/mat_file.hpp): v5/v7 through dynid's own reader (internal/mat_v5_reader.hpp), v4 and
+// v7.3 (HDF5) through libmatio.
 #include "dynid/io/mat_file.hpp"
 
 #include <matio.h>
@@ -16,9 +17,12 @@
 #include "dynid/io/modal_data_io.hpp"
 #include "dynid/mesh/error.hpp"
 #include "internal/mat_v5_check.hpp"
+#include "internal/mat_v5_reader.hpp"
 #include "internal/text_util.hpp"
 
 namespace dynid {
+
+using internal::MatArray;
 
 namespace {
 
@@ -65,23 +69,26 @@ const char* class_name(const matvar_t* v) {
   }
 }
 
-bool numeric_class(matio_classes c) { return c >= MAT_C_DOUBLE && c <= MAT_C_UINT64; }
+std::vector<std::size_t> dims_of(const matvar_t* v) {
+  std::vector<std::size_t> d;
+  for (int k = 0; k < v->rank && v->dims; ++k) d.push_back(v->dims[k]);
+  return d;
+}
 
-std::string dims_text(const matvar_t* v) {
+std::string dims_text(const std::vector<std::size_t>& dims) {
   std::string s;
-  for (int k = 0; k < v->rank; ++k) s += (k ? " x " : "") + std::to_string(v->dims[k]);
+  for (std::size_t d : dims) s += (s.empty() ? "" : " x ") + std::to_string(d);
   return s.empty() ? "0 x 0" : s;
 }
 
-// Number of elements, or -1 when the product overflows or exceeds `max` (ReaderLimits::max_mat_elements), or one
-// dimension does: an empty array's other dimensions are sizes too (fuzz_mat, 2026-11-28: a v4 file's 0 x -1560281086
-// array read as 0 x 18446744072149270530, which a matrix cannot be resized to).
-long long numel(const matvar_t* v, long long max) {
-  if (v->rank < 0 || (v->rank > 0 && !v->dims)) return -1;
+// Number of elements, or -1 when the product exceeds `max` (ReaderLimits::max_mat_elements), or one dimension does:
+// an empty array's other dimensions are sizes too (fuzz_mat, 2026-11-28: a v4 file's 0 x -1560281086 array read as
+// 0 x 18446744072149270530, which a matrix cannot be resized to).
+long long numel(const std::vector<std::size_t>& dims, long long max) {
   long double n = 1;
-  for (int k = 0; k < v->rank; ++k) {
-    if (v->dims[k] > static_cast<std::size_t>(max)) return -1;
-    n *= static_cast<long double>(v->dims[k]);
+  for (std::size_t d : dims) {
+    if (d > static_cast<std::size_t>(max)) return -1;
+    n *= static_cast<long double>(d);
   }
   if (n > static_cast<long double>(max)) return -1;
   return static_cast<long long>(n);
@@ -116,48 +123,109 @@ double element(const void* p, matio_types t, std::size_t k) {
 
 std::string int_text(double v) { return internal::format_number(v, 17); }
 
+// A variable libmatio read (v4, v7.3) as dynid's array: numeric data as doubles, sparse structure, char codes and
+// cells, each checked against the bytes libmatio holds (complex data are not copied: dynid refuses them).
+MatArray from_matio(const matvar_t* v, const std::string& who, long long max, int depth) {
+  MatArray a;
+  a.name = v->name ? v->name : "";
+  a.type = class_name(v);
+  a.dims = dims_of(v);
+  a.complex = v->isComplex != 0;
+  const long long n = numel(a.dims, max);
+  if (n < 0) throw InputError(who + ": a " + dims_text(a.dims) + " array is larger than dynid reads");
+  const int ts = type_size(v->data_type);
+  if (a.complex) return a;
+  if (v->class_type == MAT_C_SPARSE) {
+    const auto* s = static_cast<const mat_sparse_t*>(v->data);
+    if (!s || !s->jc || (s->nir > 0 && !s->ir) || (s->ndata > 0 && (!s->data || ts == 0)))
+      throw InputError(who + ": inconsistent sparse structure");
+    a.ir.assign(s->ir, s->ir + s->nir);
+    a.jc.assign(s->jc, s->jc + s->njc);
+    a.values.resize(s->ndata);
+    for (std::size_t k = 0; k < a.values.size(); ++k) a.values[k] = element(s->data, v->data_type, k);
+  } else if (v->class_type >= MAT_C_DOUBLE && v->class_type <= MAT_C_UINT64) {
+    if (n > 0 && (!v->data || ts == 0 || v->nbytes < static_cast<std::size_t>(n) * static_cast<std::size_t>(ts)))
+      throw InputError(who + ": its data is incomplete (" + std::to_string(v->nbytes) + " bytes for " +
+                       std::to_string(n) + " values)");
+    a.values.resize(static_cast<std::size_t>(n));
+    for (std::size_t k = 0; k < a.values.size(); ++k) a.values[k] = element(v->data, v->data_type, k);
+  } else if (v->class_type == MAT_C_CHAR) {
+    const int size = v->data_size > 0 ? v->data_size : 1;
+    if (n > 0 && (!v->data || v->nbytes < static_cast<std::size_t>(n) * static_cast<std::size_t>(size)))
+      throw InputError(who + ": its text is incomplete");
+    a.text.resize(static_cast<std::size_t>(n));
+    for (std::size_t k = 0; k < a.text.size(); ++k)
+      a.text[k] = size == 1   ? static_cast<const unsigned char*>(v->data)[k]
+                  : size == 2 ? static_cast<const std::uint16_t*>(v->data)[k]
+                              : static_cast<const std::uint32_t*>(v->data)[k];
+  } else if (v->class_type == MAT_C_CELL) {
+    if (depth >= 64) throw InputError(who + " is nested more than 64 levels deep (dynid reads at most that)");
+    for (long long k = 0; k < n; ++k) {
+      const std::string cell = who + " cell " + std::to_string(k + 1);
+      const matvar_t* c = Mat_VarGetCell(const_cast<matvar_t*>(v), static_cast<int>(k));
+      if (!c) throw InputError(cell + " is missing");
+      a.cells.push_back(from_matio(c, cell, max, depth + 1));
+    }
+  }
+  return a;
+}
+
 }  // namespace
 
 struct MatFile::Handle {
-  mat_t* mat = nullptr;
+  mat_t* mat = nullptr;                       // v4, v7.3
+  std::unique_ptr<internal::MatV5Reader> v5;  // v5 / v7
   ~Handle() {
     if (mat) Mat_Close(mat);
   }
   [[noreturn]] void fail(const std::string& path, const std::string& name, const std::string& what) const {
     throw InputError(path + ": variable '" + name + "': " + what);
   }
+  [[noreturn]] void missing(const std::string& path, const std::string& name, const std::string& what,
+                            const MatFile& file) const {
+    g_last_message.clear();
+    throw InputError(path + ": no variable '" + name + "' (" + what + "); the file holds: " + file.listing());
+  }
   // The variable with its data, checked for a consistent size; throws naming it.
-  Var read(const std::string& path, const std::string& name, const std::string& what, const MatFile& file) const {
+  MatArray read(const std::string& path, const std::string& name, const std::string& what, const MatFile& file) const {
+    const long long max = file.limits().max_mat_elements;
+    const auto too_large = [&](const std::vector<std::size_t>& dims) {
+      fail(path, name,
+           "a " + dims_text(dims) + " array is larger than dynid reads (" + limit_text(static_cast<double>(max)) +
+               " elements)");
+    };
+    if (v5) {
+      const std::vector<MatArray>& vars = v5->variables();
+      for (std::size_t k = 0; k < vars.size(); ++k) {
+        if (vars[k].name != name) continue;
+        if (numel(vars[k].dims, max) < 0) too_large(vars[k].dims);
+        return v5->read(k);
+      }
+      missing(path, name, what, file);
+    }
     Mat_Rewind(mat);
     Var info(Mat_VarReadInfo(mat, name.c_str()));
-    if (!info) {
-      g_last_message.clear();
-      throw InputError(path + ": no variable '" + name + "' (" + what + "); the file holds: " + file.listing());
-    }
-    const long long max = file.limits().max_mat_elements;
-    if (numel(info.get(), max) < 0)
-      fail(path, name,
-           "a " + dims_text(info.get()) + " array is larger than dynid reads (" + limit_text(static_cast<double>(max)) +
-               " elements)");
+    if (!info) missing(path, name, what, file);
+    const std::vector<std::size_t> dims = dims_of(info.get());
+    if (numel(dims, max) < 0) too_large(dims);
     // A damaged header can declare far more data than the file holds, and libmatio allocates what it declares
-    // before reading (fuzz_mat found a 4 GB request from a 1 kB file). Data never exceeds the file by more than
-    // zlib's largest ratio (about 1032:1); sparse arrays hold fewer values than their dimensions, and a v5 file's
-    // tags were checked against the arrays that hold them when it was opened (internal/mat_v5_check.hpp).
+    // before reading. Data never exceeds the file by more than zlib's largest ratio (about 1032:1); sparse arrays
+    // hold fewer values than their dimensions.
     if (info->class_type != MAT_C_SPARSE) {
       std::error_code ec;
       const double file_bytes = static_cast<double>(std::filesystem::file_size(path, ec));
       const double bytes =
-          static_cast<double>(numel(info.get(), max)) * static_cast<double>(Mat_SizeOfClass(info->class_type));
+          static_cast<double>(numel(dims, max)) * static_cast<double>(Mat_SizeOfClass(info->class_type));
       if (!ec && bytes > internal::max_inflated_bytes(file_bytes))
-        fail(path, name, "declares a " + dims_text(info.get()) + " array (" + limit_text(bytes) + " bytes) in a file of " +
-                             limit_text(file_bytes) + " bytes: the file is damaged; save it again from MATLAB or SciPy");
+        fail(path, name,
+             "declares a " + dims_text(dims) + " array (" + limit_text(bytes) + " bytes) in a file of " +
+                 limit_text(file_bytes) + " bytes: the file is damaged; save it again from MATLAB or SciPy");
     }
     info.reset();
     Mat_Rewind(mat);
     Var v(Mat_VarRead(mat, name.c_str()));
     if (!v) fail(path, name, "cannot be read; the file is damaged or uses a feature dynid does not read" + matio_says());
-    if (numel(v.get(), max) < 0) fail(path, name, "a " + dims_text(v.get()) + " array is larger than dynid reads");
-    return v;
+    return from_matio(v.get(), path + ": variable '" + name + "'", max, 0);
   }
 };
 
@@ -166,28 +234,37 @@ MatFile::MatFile(const std::string& path, const ReaderLimits& limits)
   quiet_matio();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": cannot open the file (no such file)");
-  // libmatio's Mat_Open already reads a v4 file's first header and allocates its name: v4 headers are checked
-  // first (a v5 or v7.3 file's text header is no v4 type word, so this passes them).
-  if (const std::string why = internal::v4_damage(path); !why.empty())
-    throw InputError(path + ": " + why + ": the file is damaged; save it again from MATLAB or SciPy");
-  h_->mat = Mat_Open(path.c_str(), MAT_ACC_RDONLY);
-  if (!h_->mat)
-    throw InputError(path + ": not a MATLAB .mat file (v4, v5/v7 or v7.3)" + matio_says() +
-                     "; save it from MATLAB with save(..., '-v7') or '-v7.3', or from Python with scipy.io.savemat");
-  // Before libmatio lists or reads anything: it sizes allocations by the v5 tags (internal/mat_v5_check.hpp).
-  if (Mat_GetVersion(h_->mat) == MAT_FT_MAT5) {
+  if (internal::MatV5Reader::is_v5(path)) {
+    // The walk names what is wrong with a damaged variable before anything is listed (internal/mat_v5_check.hpp);
+    // the reader then reads only what the file holds.
     bool unsupported = false;
     const std::string why = internal::v5_damage(path, &unsupported);
     if (!why.empty())
       throw InputError(
           path + ": " + why +
           (unsupported ? "; save the file without it" : ": the file is damaged; save it again from MATLAB or SciPy"));
+    h_->v5 = std::make_unique<internal::MatV5Reader>(path);
+    return;
   }
+  // libmatio's Mat_Open already reads a v4 file's first header and allocates its name: v4 headers are checked
+  // first (a v7.3 file's text header is no v4 type word, so this passes them).
+  if (const std::string why = internal::v4_damage(path); !why.empty())
+    throw InputError(path + ": " + why + ": the file is damaged; save it again from MATLAB or SciPy");
+  h_->mat = Mat_Open(path.c_str(), MAT_ACC_RDONLY);
+  if (!h_->mat)
+    throw InputError(path + ": not a MATLAB .mat file (v4, v5/v7 or v7.3)" + matio_says() +
+                     "; save it from MATLAB with save(..., '-v7') or '-v7.3', or from Python with scipy.io.savemat");
+  // A header libmatio takes for v5 but dynid's reader does not: libmatio would size its allocations by the tags.
+  if (Mat_GetVersion(h_->mat) == MAT_FT_MAT5)
+    throw InputError(path +
+                     ": a MATLAB 5 header with an unknown version or byte-order mark; save the file again "
+                     "from MATLAB or SciPy");
 }
 
 MatFile::~MatFile() = default;
 
 std::string MatFile::version() const {
+  if (h_->v5) return "MATLAB 5.0 (v5/v7)";
   switch (Mat_GetVersion(h_->mat)) {
     case MAT_FT_MAT73: return "MATLAB 7.3 (HDF5)";
     case MAT_FT_MAT4: return "MATLAB 4";
@@ -197,17 +274,16 @@ std::string MatFile::version() const {
 
 std::vector<MatFile::Info> MatFile::variables() const {
   std::vector<Info> out;
+  if (h_->v5) {
+    for (const MatArray& a : h_->v5->variables()) out.push_back({a.name, a.type, a.dims, a.complex});
+    return out;
+  }
   Mat_Rewind(h_->mat);
   // Bounded: a damaged file must not list forever.
   for (int k = 0; k < 1000000; ++k) {
     Var v(Mat_VarReadNextInfo(h_->mat));
     if (!v) break;
-    Info i;
-    i.name = v->name ? v->name : "";
-    i.type = class_name(v.get());
-    for (int d = 0; d < v->rank && v->dims; ++d) i.dims.push_back(v->dims[d]);
-    i.complex = v->isComplex != 0;
-    out.push_back(std::move(i));
+    out.push_back({v->name ? v->name : "", class_name(v.get()), dims_of(v.get()), v->isComplex != 0});
   }
   g_last_message.clear();
   return out;
@@ -222,58 +298,56 @@ bool MatFile::has(const std::string& name) const {
 std::string MatFile::listing() const {
   std::string s;
   const std::vector<Info> vars = variables();
-  for (std::size_t k = 0; k < vars.size() && k < 40; ++k) {
-    std::string d;
-    for (std::size_t j = 0; j < vars[k].dims.size(); ++j) d += (j ? " x " : "") + std::to_string(vars[k].dims[j]);
-    s += (k ? ", " : "") + vars[k].name + " (" + d + " " + vars[k].type + (vars[k].complex ? " complex" : "") + ")";
-  }
+  for (std::size_t k = 0; k < vars.size() && k < 40; ++k)
+    s += (k ? ", " : "") + vars[k].name + " (" + dims_text(vars[k].dims) + " " + vars[k].type +
+         (vars[k].complex ? " complex" : "") + ")";
   if (vars.size() > 40) s += ", ... (" + std::to_string(vars.size()) + " variables)";
   return s.empty() ? "no variables" : s;
 }
 
 namespace {
 
-// A matvar's real numeric content as a dense matrix (rows x cols), checked; `who` names it; `max`: numel's.
-Eigen::MatrixXd dense_of(const matvar_t* v, const std::string& who, long long max) {
-  if (v->isComplex) throw InputError(who + " is complex; real values are needed");
-  if (v->rank > 2) throw InputError(who + " is a " + dims_text(v) + " array; a matrix (2-D) is needed");
-  const auto rows = static_cast<Eigen::Index>(v->rank >= 1 ? v->dims[0] : 0);
-  const auto cols = static_cast<Eigen::Index>(v->rank >= 2 ? v->dims[1] : 1);
+// The column pointers and row indices of sparse array `a` (rows x cols), checked: throws naming `who`.
+void check_sparse(const MatArray& a, std::size_t rows, std::size_t cols, const std::string& who) {
+  const std::size_t nnz = std::min(a.ir.size(), a.values.size());
+  if (a.jc.size() != cols + 1)
+    throw InputError(who + ": inconsistent sparse structure (column pointers " + std::to_string(a.jc.size()) + " for " +
+                     std::to_string(cols) + " columns)");
+  for (std::size_t j = 0; j < cols; ++j) {
+    if (a.jc[j] > a.jc[j + 1] || a.jc[j + 1] > nnz)
+      throw InputError(who + ": inconsistent sparse structure (column " + std::to_string(j + 1) + ")");
+    for (std::uint32_t k = a.jc[j]; k < a.jc[j + 1]; ++k)
+      if (a.ir[k] >= rows)
+        throw InputError(who + ": sparse row index " + std::to_string(a.ir[k] + 1ull) + " outside " +
+                         std::to_string(rows) + " rows");
+  }
+}
+
+// An array's real numeric content as a dense matrix (rows x cols), checked; `who` names it; `max`: numel's.
+Eigen::MatrixXd dense_of(const MatArray& v, const std::string& who, long long max) {
+  if (v.complex) throw InputError(who + " is complex; real values are needed");
+  if (v.dims.size() > 2) throw InputError(who + " is a " + dims_text(v.dims) + " array; a matrix (2-D) is needed");
+  if (v.type != "sparse" && !v.numeric())
+    throw InputError(who + " is a " + v.type + " (" + dims_text(v.dims) + "); a numeric matrix is needed");
+  if (numel(v.dims, max) < 0) throw InputError(who + ": a " + dims_text(v.dims) + " array is larger than dynid reads");
+  const std::size_t rows = v.dims.size() >= 1 ? v.dims[0] : 0, cols = v.dims.size() >= 2 ? v.dims[1] : 1;
   Eigen::MatrixXd A;
   try {
-    A.resize(rows, cols);
+    A.resize(static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(cols));
   } catch (const std::bad_alloc&) {
-    throw InputError(who + " is a " + dims_text(v) + " matrix; held dense it does not fit in memory");
+    throw InputError(who + " is a " + dims_text(v.dims) + " matrix; held dense it does not fit in memory");
   }
-  if (v->class_type == MAT_C_SPARSE) {
+  if (v.type == "sparse") {
+    check_sparse(v, rows, cols, who);
     A.setZero();
-    const auto* s = static_cast<const mat_sparse_t*>(v->data);
-    if (!s) throw InputError(who + ": sparse data missing");
-    const int ts = type_size(v->data_type);
-    if (ts == 0) throw InputError(who + ": sparse values of an unsupported type (" + std::to_string(v->data_type) + ")");
-    if (static_cast<Eigen::Index>(s->njc) != cols + 1 || !s->jc || (s->nir > 0 && !s->ir) || s->ndata > s->nir ||
-        (s->ndata > 0 && !s->data))
-      throw InputError(who + ": inconsistent sparse structure (column pointers " + std::to_string(s->njc) + " for " +
-                       std::to_string(cols) + " columns)");
-    for (Eigen::Index j = 0; j < cols; ++j) {
-      const mat_uint32_t a = s->jc[j], b = s->jc[j + 1];
-      if (a > b || b > s->ndata) throw InputError(who + ": inconsistent sparse structure (column " + std::to_string(j + 1) + ")");
-      for (mat_uint32_t k = a; k < b; ++k) {
-        if (static_cast<Eigen::Index>(s->ir[k]) >= rows)
-          throw InputError(who + ": sparse row index " + std::to_string(s->ir[k] + 1) + " outside " + std::to_string(rows) + " rows");
-        A(s->ir[k], j) += element(s->data, v->data_type, k);
-      }
-    }
+    for (std::size_t j = 0; j < cols; ++j)
+      for (std::uint32_t k = v.jc[j]; k < v.jc[j + 1]; ++k) A(v.ir[k], static_cast<Eigen::Index>(j)) += v.values[k];
     return A;
   }
-  if (!numeric_class(v->class_type))
-    throw InputError(who + " is a " + std::string(class_name(v)) + " (" + dims_text(v) + "); a numeric matrix is needed");
-  const long long n = numel(v, max);
-  const int ts = type_size(v->data_type);
-  if (n > 0 && (!v->data || ts == 0 || v->nbytes < static_cast<std::size_t>(n) * static_cast<std::size_t>(ts)))
-    throw InputError(who + ": its data is incomplete (" + std::to_string(v->nbytes) + " bytes for " + std::to_string(n) + " values)");
-  for (Eigen::Index j = 0; j < cols; ++j)
-    for (Eigen::Index i = 0; i < rows; ++i) A(i, j) = element(v->data, v->data_type, static_cast<std::size_t>(i + j * rows));
+  if (v.values.size() != rows * cols)
+    throw InputError(who + ": its data is incomplete (" + std::to_string(v.values.size()) + " values for " +
+                     std::to_string(rows * cols) + ")");
+  std::copy(v.values.begin(), v.values.end(), A.data());
   return A;
 }
 
@@ -288,27 +362,24 @@ std::string who(const std::string& path, const std::string& name, const std::str
   return path + ": variable '" + name + "' (" + what + ")";
 }
 
-std::vector<std::string> strings_of(const matvar_t* v, const std::string& w, long long max) {
+std::vector<std::string> strings_of(const MatArray& v, const std::string& w, long long max) {
   std::vector<std::string> out;
-  if (v->class_type == MAT_C_CHAR) {
-    if (v->rank != 2) throw InputError(w + " is a " + dims_text(v) + " char array; one string per row is needed");
-    const std::size_t rows = v->dims[0], cols = v->dims[1];
+  if (v.type == "char") {
+    if (v.dims.size() != 2)
+      throw InputError(w + " is a " + dims_text(v.dims) + " char array; one string per row is needed");
+    const std::size_t rows = v.dims[0], cols = v.dims[1];
     // Each row is a string even when the text has no columns: a row counts as one element at least (fuzz_mat,
     // 2026-11-28: a cell holding a 10^8 x 0 char array, 3.2 GB of empty strings).
-    if (numel(v, max) < 0 || static_cast<long double>(rows) * static_cast<long double>(std::max<std::size_t>(cols, 1)) >
-                                 static_cast<long double>(max))
-      throw InputError(w + " is a " + dims_text(v) + " char array, larger than dynid reads (" +
+    if (numel(v.dims, max) < 0 ||
+        static_cast<long double>(rows) * static_cast<long double>(std::max<std::size_t>(cols, 1)) >
+            static_cast<long double>(max))
+      throw InputError(w + " is a " + dims_text(v.dims) + " char array, larger than dynid reads (" +
                        limit_text(static_cast<double>(max)) + " elements)");
-    const int ts = v->data_size > 0 ? v->data_size : 1;
-    if (rows * cols > 0 && (!v->data || v->nbytes < rows * cols * static_cast<std::size_t>(ts)))
-      throw InputError(w + ": its text is incomplete");
+    if (v.text.size() != rows * cols) throw InputError(w + ": its text is incomplete");
     for (std::size_t i = 0; i < rows; ++i) {
       std::string s;
       for (std::size_t j = 0; j < cols; ++j) {
-        const std::size_t k = i + j * rows;
-        unsigned code = ts == 1 ? static_cast<const unsigned char*>(v->data)[k]
-                        : ts == 2 ? static_cast<const std::uint16_t*>(v->data)[k]
-                                  : static_cast<const std::uint32_t*>(v->data)[k];
+        const std::uint32_t code = v.text[i + j * rows];
         s += code < 128 ? static_cast<char>(code) : '?';
       }
       while (!s.empty() && (s.back() == ' ' || s.back() == '\0')) s.pop_back();
@@ -316,24 +387,21 @@ std::vector<std::string> strings_of(const matvar_t* v, const std::string& w, lon
     }
     return out;
   }
-  if (v->class_type == MAT_C_CELL) {
-    const long long n = numel(v, max);
-    for (long long k = 0; k < n; ++k) {
-      matvar_t* c = Mat_VarGetCell(const_cast<matvar_t*>(v), static_cast<int>(k));
-      if (!c) throw InputError(w + ": cell " + std::to_string(k + 1) + " is missing");
-      const std::vector<std::string> s = strings_of(c, w + " cell " + std::to_string(k + 1), max);
+  if (v.type == "cell") {
+    for (std::size_t k = 0; k < v.cells.size(); ++k) {
+      const std::vector<std::string> s = strings_of(v.cells[k], w + " cell " + std::to_string(k + 1), max);
       out.push_back(s.empty() ? std::string() : s[0]);
     }
     return out;
   }
-  throw InputError(w + " is a " + std::string(class_name(v)) + "; text is needed (a char array or a cell array of strings)");
+  throw InputError(w + " is a " + v.type + "; text is needed (a char array or a cell array of strings)");
 }
 
 }  // namespace
 
 Eigen::MatrixXd MatFile::matrix(const std::string& name, const std::string& what) const {
-  Var v = h_->read(path_, name, what, *this);
-  Eigen::MatrixXd A = dense_of(v.get(), who(path_, name, what), limits_.max_mat_elements);
+  const MatArray v = h_->read(path_, name, what, *this);
+  Eigen::MatrixXd A = dense_of(v, who(path_, name, what), limits_.max_mat_elements);
   require_finite(A, who(path_, name, what));
   return A;
 }
@@ -347,39 +415,30 @@ Eigen::VectorXd MatFile::vector(const std::string& name, const std::string& what
 }
 
 SparseMatrix MatFile::sparse(const std::string& name, const std::string& what) const {
-  Var v = h_->read(path_, name, what, *this);
+  const MatArray x = h_->read(path_, name, what, *this);
   const std::string w = who(path_, name, what);
-  const matvar_t* x = v.get();
-  if (x->rank != 2 || x->dims[0] != x->dims[1])
-    throw InputError(w + " is " + dims_text(x) + "; a square matrix is needed");
-  if (x->class_type != MAT_C_SPARSE) {
+  if (x.dims.size() != 2 || x.dims[0] != x.dims[1])
+    throw InputError(w + " is " + dims_text(x.dims) + "; a square matrix is needed");
+  if (x.type != "sparse") {
     const Eigen::MatrixXd D = dense_of(x, w, limits_.max_mat_elements);
     require_finite(D, w);
     SparseMatrix A = D.sparseView();
     A.makeCompressed();
     return A;
   }
-  if (x->isComplex) throw InputError(w + " is complex; real values are needed");
-  const auto* s = static_cast<const mat_sparse_t*>(x->data);
-  const auto n = static_cast<Eigen::Index>(x->dims[0]);
-  if (!s || s->njc != static_cast<mat_uint32_t>(n + 1) || !s->jc || (s->nir > 0 && !s->ir) || s->ndata > s->nir ||
-      (s->ndata > 0 && !s->data) || type_size(x->data_type) == 0)
-    throw InputError(w + ": inconsistent sparse structure");
+  if (x.complex) throw InputError(w + " is complex; real values are needed");
+  const std::size_t n = x.dims[0];
+  check_sparse(x, n, n, w);
   std::vector<Eigen::Triplet<double, int>> t;
-  t.reserve(s->ndata);
-  for (Eigen::Index j = 0; j < n; ++j) {
-    const mat_uint32_t a = s->jc[j], b = s->jc[j + 1];
-    if (a > b || b > s->ndata) throw InputError(w + ": inconsistent sparse structure (column " + std::to_string(j + 1) + ")");
-    for (mat_uint32_t k = a; k < b; ++k) {
-      if (static_cast<Eigen::Index>(s->ir[k]) >= n)
-        throw InputError(w + ": sparse row index " + std::to_string(s->ir[k] + 1) + " outside " + std::to_string(n) + " rows");
-      const double val = element(s->data, x->data_type, k);
-      if (!std::isfinite(val))
-        throw InputError(w + ": entry (" + std::to_string(s->ir[k] + 1) + ", " + std::to_string(j + 1) + ") is not finite");
-      t.emplace_back(static_cast<int>(s->ir[k]), static_cast<int>(j), val);
+  t.reserve(x.jc[n]);
+  for (std::size_t j = 0; j < n; ++j)
+    for (std::uint32_t k = x.jc[j]; k < x.jc[j + 1]; ++k) {
+      if (!std::isfinite(x.values[k]))
+        throw InputError(w + ": entry (" + std::to_string(x.ir[k] + 1ull) + ", " + std::to_string(j + 1) +
+                         ") is not finite");
+      t.emplace_back(static_cast<int>(x.ir[k]), static_cast<int>(j), x.values[k]);
     }
-  }
-  SparseMatrix A(n, n);
+  SparseMatrix A(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
   A.setFromTriplets(t.begin(), t.end());
   A.makeCompressed();
   return A;
@@ -393,22 +452,17 @@ double MatFile::scalar(const std::string& name, const std::string& what) const {
 }
 
 std::vector<std::string> MatFile::strings(const std::string& name, const std::string& what) const {
-  Var v = h_->read(path_, name, what, *this);
-  return strings_of(v.get(), who(path_, name, what), limits_.max_mat_elements);
+  return strings_of(h_->read(path_, name, what, *this), who(path_, name, what), limits_.max_mat_elements);
 }
 
 std::vector<Eigen::MatrixXd> MatFile::matrices(const std::string& name, const std::string& what) const {
-  Var v = h_->read(path_, name, what, *this);
+  const MatArray v = h_->read(path_, name, what, *this);
   const std::string w = who(path_, name, what);
-  if (v->class_type != MAT_C_CELL)
-    throw InputError(w + " is a " + std::string(class_name(v.get())) + "; a cell array of matrices is needed");
+  if (v.type != "cell") throw InputError(w + " is a " + v.type + "; a cell array of matrices is needed");
   std::vector<Eigen::MatrixXd> out;
-  const long long n = numel(v.get(), limits_.max_mat_elements);
-  for (long long k = 0; k < n; ++k) {
-    matvar_t* c = Mat_VarGetCell(v.get(), static_cast<int>(k));
+  for (std::size_t k = 0; k < v.cells.size(); ++k) {
     const std::string wc = w + " cell " + std::to_string(k + 1);
-    if (!c) throw InputError(wc + " is missing");
-    out.push_back(dense_of(c, wc, limits_.max_mat_elements));
+    out.push_back(dense_of(v.cells[k], wc, limits_.max_mat_elements));
     require_finite(out.back(), wc);
   }
   return out;

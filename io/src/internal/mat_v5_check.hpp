@@ -1,4 +1,7 @@
-// A check of every variable of a MATLAB v5 file before libmatio reads it (io/src/mat_v5_check.cpp).
+// A check of every variable of a MATLAB v5 file when MatFile opens it (io/src/mat_v5_check.cpp). Written to protect
+// libmatio, which read v5 files until 2026-11-29 and sizes its allocations by the tags; dynid's own reader
+// (internal/mat_v5_reader.hpp) reads them now, and this walk still runs first: it names the damaged variable and tag
+// before anything is listed, and refuses the layouts libmatio read differently (the reasons below are libmatio's).
 #pragma once
 
 #include <string>
