@@ -1,5 +1,5 @@
 // fuzz_mat: the input is the content of a MATLAB .mat file (v4, v5/v7 with compressed variables, v7.3 HDF5) for
-// MatFile (dynid's v5 reader, instrumented; libmatio for v4 and v7.3): every variable is listed and read as a
+// MatFile (dynid's v5 and v4 readers, instrumented; libmatio for v7.3): every variable is listed and read as a
 // matrix, a sparse matrix, text and a cell array of matrices, and the three readers run with their default variable
 // names (a model of the first variables, a recording, modal data). The bytes go to an in-memory file (memfd), since
 // libmatio reads files by name. libmatio and libhdf5 are Debian's (not instrumented): the target finds crashes and

@@ -1,8 +1,8 @@
-// dynid's MATLAB v5 reader (io/src/mat_v5_reader.cpp) against libmatio, the reader dynid used for v5 files before
-// and still uses for v4 and v7.3: files written by libmatio itself (every class dynid reads, stored and compressed)
-// and the real MATLAB files of ../shared are read by both, and every value must agree exactly (the same stored
-// numbers converted to double: tolerance 0). Layouts neither SciPy nor libmatio writes here are built by hand:
-// big-endian files, and text in UTF-16 and UTF-32.
+// dynid's MATLAB v5 and v4 readers (io/src/mat_v5_reader.cpp, mat_v4_reader.cpp) against libmatio, the reader
+// dynid used for them before and still uses for v7.3: files written by libmatio itself (every class dynid reads;
+// v5 stored and compressed, and v4) and the real MATLAB files of ../shared are read by both, and every value must
+// agree exactly (the same stored numbers converted to double: tolerance 0). Layouts neither SciPy nor libmatio writes
+// here are built by hand: big-endian files, and text in UTF-16 and UTF-32.
 #include <gtest/gtest.h>
 #include <matio.h>
 
@@ -55,6 +55,13 @@ double ValueOf(const void* p, matio_types t, std::size_t k) {
       ADD_FAILURE() << "unexpected matio type " << t;
       return 0;
   }
+}
+
+// Writes `bytes` to file `name` of `dir`; returns its path.
+std::string WriteBytes(const test::ScratchDir& dir, const std::string& name, const std::string& bytes) {
+  const std::string path = dir.path(name);
+  std::ofstream(path, std::ios::binary) << bytes;
+  return path;
 }
 
 // Compares every variable dynid lists in `path` with what libmatio reads; returns how many values were compared.
@@ -200,6 +207,137 @@ TEST(MatV5Reader, AgreesWithLibmatioOnFilesLibmatioWrote) {
   }
 }
 
+// Writes with libmatio a v4 file holding every class v4 has: numeric matrices of its six precisions, text and a
+// sparse matrix.
+void WriteV4WithLibmatio(const std::string& path) {
+  const MatPtr m(Mat_CreateVer(path.c_str(), nullptr, MAT_FT_MAT4));
+  ASSERT_TRUE(m);
+  const auto put = [&](matvar_t* v) {
+    ASSERT_NE(v, nullptr);
+    EXPECT_EQ(Mat_VarWrite(m.get(), v, MAT_COMPRESSION_NONE), 0);
+    Mat_VarFree(v);
+  };
+  std::size_t d23[2] = {2, 3}, d15[2] = {1, 5}, d00[2] = {0, 0}, d33[2] = {3, 3};
+  double a[6] = {1.5, -2, 3e-300, 4e300, 0, -0.25};
+  put(Mat_VarCreate("a", MAT_C_DOUBLE, MAT_T_DOUBLE, 2, d23, a, 0));
+  float f[5] = {1.25f, -7, 3.5e30f, 0, 1e-30f};
+  put(Mat_VarCreate("f", MAT_C_SINGLE, MAT_T_SINGLE, 2, d15, f, 0));
+  std::int32_t i32[5] = {-2147483647 - 1, -5, 0, 7, 2147483647};
+  put(Mat_VarCreate("i32", MAT_C_INT32, MAT_T_INT32, 2, d15, i32, 0));
+  std::int16_t i16[5] = {-32768, -1, 0, 1, 32767};
+  put(Mat_VarCreate("i16", MAT_C_INT16, MAT_T_INT16, 2, d15, i16, 0));
+  std::uint16_t u16[5] = {0, 1, 2, 65535, 300};
+  put(Mat_VarCreate("u16", MAT_C_UINT16, MAT_T_UINT16, 2, d15, u16, 0));
+  std::uint8_t u8[5] = {0, 1, 128, 255, 7};
+  put(Mat_VarCreate("u8", MAT_C_UINT8, MAT_T_UINT8, 2, d15, u8, 0));
+  put(Mat_VarCreate("e", MAT_C_DOUBLE, MAT_T_DOUBLE, 2, d00, nullptr, 0));
+  char text[] = "1u2u3r";
+  put(Mat_VarCreate("t", MAT_C_CHAR, MAT_T_UINT8, 2, d23, text, 0));
+  mat_uint32_t ir[3] = {0, 2, 1}, jc[4] = {0, 2, 2, 3};
+  double sv[3] = {4, -1, 2.5};
+  mat_sparse_t sparse{};
+  sparse.nzmax = 3;
+  sparse.ir = ir;
+  sparse.nir = 3;
+  sparse.jc = jc;
+  sparse.njc = 4;
+  sparse.ndata = 3;
+  sparse.data = sv;
+  put(Mat_VarCreate("K", MAT_C_SPARSE, MAT_T_DOUBLE, 2, d33, &sparse, 0));
+}
+
+TEST(MatV4Reader, AgreesWithLibmatioOnFilesLibmatioWrote) {
+  const test::ScratchDir dir("mat-v4-libmatio");
+  const std::string path = dir.path("v4.mat");
+  WriteV4WithLibmatio(path);
+  EXPECT_EQ(CompareWithLibmatio(path), 6u + 5 * 5 + 6 + 3);  // a, f ... u8, t, K's nonzeros
+  const MatFile f(path);
+  EXPECT_EQ(f.version(), "MATLAB 4");
+  EXPECT_EQ(f.strings("t", "text"), (std::vector<std::string>{"123", "uur"}));
+  const SparseMatrix K = f.sparse("K", "stiffness");
+  EXPECT_EQ(K.nonZeros(), 3);
+  EXPECT_EQ(K.coeff(2, 0), -1.0);
+  EXPECT_EQ(K.coeff(1, 2), 2.5);
+}
+
+TEST(MatV4Reader, BigEndianAndUnsortedSparse) {
+  // v4 files written on a big-endian machine (type word 1000 + ...): x = [1 2; 3 4], and a 3 x 2 sparse matrix whose
+  // entries are stored out of column order (as a v4 file may hold them): (2,2) 5, (1,1) 6, (3,1) 7.
+  const test::ScratchDir dir("mat-v4-endian");
+  for (const bool big : {false, true}) {
+    SCOPED_TRACE(big ? "big-endian" : "little-endian");
+    std::string bytes;
+    const auto put = [&](std::int32_t type, std::int32_t rows, std::int32_t cols, const std::vector<double>& values) {
+      const std::int32_t header[5] = {type + (big ? 1000 : 0), rows, cols, 0, 2};
+      for (std::int32_t w : header) {
+        auto u = static_cast<std::uint32_t>(w);
+        if (big) u = __builtin_bswap32(u);
+        bytes.append(reinterpret_cast<const char*>(&u), 4);
+      }
+      bytes += std::string(1, type == 0 ? 'x' : 'S') + '\0';
+      for (double d : values) {
+        std::uint64_t u;
+        std::memcpy(&u, &d, 8);
+        if (big) u = __builtin_bswap64(u);
+        bytes.append(reinterpret_cast<const char*>(&u), 8);
+      }
+    };
+    put(0, 2, 2, {1, 3, 2, 4});
+    put(2, 4, 3, {2, 1, 3, 3, /* j */ 2, 1, 1, 2, /* values */ 5, 6, 7, 0});
+    const MatFile f(WriteBytes(dir, big ? "big.mat" : "little.mat", bytes));
+    EXPECT_EQ(f.version(), "MATLAB 4");
+    const Eigen::MatrixXd x = f.matrix("x", "test");
+    EXPECT_EQ(x(0, 1), 2.0);
+    EXPECT_EQ(x(1, 0), 3.0);
+    const std::vector<MatFile::Info> vars = f.variables();
+    ASSERT_EQ(vars.size(), 2u);
+    EXPECT_EQ(vars[1].dims, (std::vector<std::size_t>{3, 2}));
+    const Eigen::MatrixXd S = f.matrix("S", "test");
+    Eigen::MatrixXd want(3, 2);
+    want << 6, 0, 0, 5, 7, 0;
+    EXPECT_EQ(S, want);
+  }
+}
+
+TEST(MatFileLimits, ASparseMatrixCountsItsRowsAndColumnsNotItsDenseSize) {
+  // A 100,000-DOF sparse stiffness matrix has 10^10 dense entries, more than max_mat_elements (2 x 10^9): the limit
+  // used to refuse every sparse matrix above 44,721 DOFs. Its rows and columns count against max_matrix_dimension.
+  const test::ScratchDir dir("mat-large-sparse");
+  for (const mat_ft version : {MAT_FT_MAT5, MAT_FT_MAT4}) {
+    const std::string path = dir.path(version == MAT_FT_MAT5 ? "v5.mat" : "v4.mat");
+    {
+      const MatPtr m(Mat_CreateVer(path.c_str(), nullptr, version));
+      ASSERT_TRUE(m);
+      std::vector<mat_uint32_t> ir = {0, 99999}, jc(100001, 1);
+      jc[0] = 0;
+      jc[100000] = 2;
+      double values[2] = {3, 4};
+      mat_sparse_t sparse{};
+      sparse.nzmax = 2;
+      sparse.ir = ir.data();
+      sparse.nir = 2;
+      sparse.jc = jc.data();
+      sparse.njc = 100001;
+      sparse.ndata = 2;
+      sparse.data = values;
+      std::size_t dims[2] = {100000, 100000};
+      matvar_t* v = Mat_VarCreate("K", MAT_C_SPARSE, MAT_T_DOUBLE, 2, dims, &sparse, MAT_F_DONT_COPY_DATA);
+      ASSERT_NE(v, nullptr);
+      EXPECT_EQ(Mat_VarWrite(m.get(), v, MAT_COMPRESSION_NONE), 0);
+      v->data = nullptr;  // the arrays are the test's
+      Mat_VarFree(v);
+    }
+    const SparseMatrix K = MatFile(path).sparse("K", "stiffness");
+    EXPECT_EQ(K.rows(), 100000);
+    EXPECT_EQ(K.coeff(0, 0), 3.0);
+    EXPECT_EQ(K.coeff(99999, 99999), 4.0);
+    ReaderLimits limits;
+    limits.max_matrix_dimension = 50000;
+    EXPECT_HAS(test::ErrorOf([&] { MatFile(path, limits).sparse("K", "stiffness"); }),
+               "variable 'K': a sparse 100000 x 100000 matrix is larger than dynid reads (50000 rows or columns)");
+  }
+}
+
 TEST(MatV5Reader, AgreesWithLibmatioOnRealFiles) {
   // The fuzz target's intact seeds (SciPy) and the real SMU / Georgia Tech files of ../shared/data (MATLAB).
   std::size_t compared = 0;
@@ -233,12 +371,6 @@ std::string Words(bool big, std::initializer_list<std::uint32_t> words, const st
     f.append(reinterpret_cast<const char*>(&u), 8);
   }
   return f;
-}
-
-std::string WriteBytes(const test::ScratchDir& dir, const std::string& name, const std::string& bytes) {
-  const std::string path = dir.path(name);
-  std::ofstream(path, std::ios::binary) << bytes;
-  return path;
 }
 
 TEST(MatV5Reader, BigEndianFilesReadAsTheirLittleEndianTwins) {

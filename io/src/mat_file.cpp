@@ -1,4 +1,4 @@
-// MATLAB .mat files (dynid/io/mat_file.hpp): v5/v7 through dynid's own reader (internal/mat_v5_reader.hpp), v4 and
+// MATLAB .mat files (dynid/io/mat_file.hpp): v5/v7 through dynid's own reader (internal/mat_reader.hpp), v4 and
 // v7.3 (HDF5) through libmatio.
 #include "dynid/io/mat_file.hpp"
 
@@ -16,8 +16,8 @@
 #include "dynid/io/limits.hpp"
 #include "dynid/io/modal_data_io.hpp"
 #include "dynid/mesh/error.hpp"
+#include "internal/mat_reader.hpp"
 #include "internal/mat_v5_check.hpp"
-#include "internal/mat_v5_reader.hpp"
 #include "internal/text_util.hpp"
 
 namespace dynid {
@@ -123,7 +123,7 @@ double element(const void* p, matio_types t, std::size_t k) {
 
 std::string int_text(double v) { return internal::format_number(v, 17); }
 
-// A variable libmatio read (v4, v7.3) as dynid's array: numeric data as doubles, sparse structure, char codes and
+// A variable libmatio read (v7.3) as dynid's array: numeric data as doubles, sparse structure, char codes and
 // cells, each checked against the bytes libmatio holds (complex data are not copied: dynid refuses them).
 MatArray from_matio(const matvar_t* v, const std::string& who, long long max, int depth) {
   MatArray a;
@@ -173,8 +173,8 @@ MatArray from_matio(const matvar_t* v, const std::string& who, long long max, in
 }  // namespace
 
 struct MatFile::Handle {
-  mat_t* mat = nullptr;                       // v4, v7.3
-  std::unique_ptr<internal::MatV5Reader> v5;  // v5 / v7
+  mat_t* mat = nullptr;                      // v7.3 (HDF5): libmatio
+  std::unique_ptr<internal::MatReader> own;  // v5 / v7 and v4: dynid's readers
   ~Handle() {
     if (mat) Mat_Close(mat);
   }
@@ -189,17 +189,25 @@ struct MatFile::Handle {
   // The variable with its data, checked for a consistent size; throws naming it.
   MatArray read(const std::string& path, const std::string& name, const std::string& what, const MatFile& file) const {
     const long long max = file.limits().max_mat_elements;
-    const auto too_large = [&](const std::vector<std::size_t>& dims) {
-      fail(path, name,
-           "a " + dims_text(dims) + " array is larger than dynid reads (" + limit_text(static_cast<double>(max)) +
-               " elements)");
+    // A dense array's elements count against max_mat_elements; a sparse matrix's rows and columns against
+    // max_matrix_dimension, as a Matrix Market file's do (its nonzeros are counted from the data).
+    const auto check_size = [&](const std::string& type, const std::vector<std::size_t>& dims) {
+      const auto largest = static_cast<double>(dims.empty() ? 0 : *std::max_element(dims.begin(), dims.end()));
+      if (type == "sparse" && largest > static_cast<double>(file.limits().max_matrix_dimension))
+        fail(path, name,
+             "a sparse " + dims_text(dims) + " matrix is larger than dynid reads (" +
+                 limit_text(static_cast<double>(file.limits().max_matrix_dimension)) + " rows or columns)");
+      if (type != "sparse" && numel(dims, max) < 0)
+        fail(path, name,
+             "a " + dims_text(dims) + " array is larger than dynid reads (" + limit_text(static_cast<double>(max)) +
+                 " elements)");
     };
-    if (v5) {
-      const std::vector<MatArray>& vars = v5->variables();
+    if (own) {
+      const std::vector<MatArray>& vars = own->variables();
       for (std::size_t k = 0; k < vars.size(); ++k) {
         if (vars[k].name != name) continue;
-        if (numel(vars[k].dims, max) < 0) too_large(vars[k].dims);
-        return v5->read(k);
+        check_size(vars[k].type, vars[k].dims);
+        return own->read(k);
       }
       missing(path, name, what, file);
     }
@@ -207,7 +215,7 @@ struct MatFile::Handle {
     Var info(Mat_VarReadInfo(mat, name.c_str()));
     if (!info) missing(path, name, what, file);
     const std::vector<std::size_t> dims = dims_of(info.get());
-    if (numel(dims, max) < 0) too_large(dims);
+    check_size(class_name(info.get()), dims);
     // A damaged header can declare far more data than the file holds, and libmatio allocates what it declares
     // before reading. Data never exceeds the file by more than zlib's largest ratio (about 1032:1); sparse arrays
     // hold fewer values than their dimensions.
@@ -234,7 +242,8 @@ MatFile::MatFile(const std::string& path, const ReaderLimits& limits)
   quiet_matio();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": cannot open the file (no such file)");
-  if (internal::MatV5Reader::is_v5(path)) {
+  const unsigned version = internal::mat_header_version(path);
+  if (version == 0x0100) {
     // The walk names what is wrong with a damaged variable before anything is listed (internal/mat_v5_check.hpp);
     // the reader then reads only what the file holds.
     bool unsupported = false;
@@ -243,39 +252,30 @@ MatFile::MatFile(const std::string& path, const ReaderLimits& limits)
       throw InputError(
           path + ": " + why +
           (unsupported ? "; save the file without it" : ": the file is damaged; save it again from MATLAB or SciPy"));
-    h_->v5 = std::make_unique<internal::MatV5Reader>(path);
+    h_->own = std::make_unique<internal::MatV5Reader>(path);
     return;
   }
-  // libmatio's Mat_Open already reads a v4 file's first header and allocates its name: v4 headers are checked
-  // first (a v7.3 file's text header is no v4 type word, so this passes them).
-  if (const std::string why = internal::v4_damage(path); !why.empty())
-    throw InputError(path + ": " + why + ": the file is damaged; save it again from MATLAB or SciPy");
+  if (version != 0x0200) {  // no v5 / v7.3 header: a v4 file, or no MAT-file (the reader says which)
+    h_->own = std::make_unique<internal::MatV4Reader>(path);
+    return;
+  }
   h_->mat = Mat_Open(path.c_str(), MAT_ACC_RDONLY);
-  if (!h_->mat)
+  if (!h_->mat || Mat_GetVersion(h_->mat) != MAT_FT_MAT73)
     throw InputError(path + ": not a MATLAB .mat file (v4, v5/v7 or v7.3)" + matio_says() +
                      "; save it from MATLAB with save(..., '-v7') or '-v7.3', or from Python with scipy.io.savemat");
-  // A header libmatio takes for v5 but dynid's reader does not: libmatio would size its allocations by the tags.
-  if (Mat_GetVersion(h_->mat) == MAT_FT_MAT5)
-    throw InputError(path +
-                     ": a MATLAB 5 header with an unknown version or byte-order mark; save the file again "
-                     "from MATLAB or SciPy");
 }
 
 MatFile::~MatFile() = default;
 
 std::string MatFile::version() const {
-  if (h_->v5) return "MATLAB 5.0 (v5/v7)";
-  switch (Mat_GetVersion(h_->mat)) {
-    case MAT_FT_MAT73: return "MATLAB 7.3 (HDF5)";
-    case MAT_FT_MAT4: return "MATLAB 4";
-    default: return "MATLAB 5.0 (v5/v7)";
-  }
+  if (h_->own) return h_->own->version();
+  return "MATLAB 7.3 (HDF5)";
 }
 
 std::vector<MatFile::Info> MatFile::variables() const {
   std::vector<Info> out;
-  if (h_->v5) {
-    for (const MatArray& a : h_->v5->variables()) out.push_back({a.name, a.type, a.dims, a.complex});
+  if (h_->own) {
+    for (const MatArray& a : h_->own->variables()) out.push_back({a.name, a.type, a.dims, a.complex});
     return out;
   }
   Mat_Rewind(h_->mat);

@@ -1,4 +1,4 @@
-// dynid's MATLAB v5 reader (internal/mat_v5_reader.hpp).
+// dynid's MATLAB v5 reader (internal/mat_reader.hpp).
 //
 // v5 layout (MathWorks, "MAT-File Format"): a 128-byte header whose last two bytes tell the byte order, then data
 // elements, each an 8-byte tag (type, byte count) and its data padded to 8 bytes; a tag whose upper 16 bits are not
@@ -10,8 +10,6 @@
 // Every count this reader allocates by is bounded by the bytes an element holds: a dimension product is checked
 // against the data before a vector is sized, a cell count against the bytes of its array (8 at least per cell), and a
 // compressed variable is inflated as its stream yields bytes, never into a buffer of its declared size.
-#include "internal/mat_v5_reader.hpp"
-
 #include <zlib.h>
 
 #include <algorithm>
@@ -23,6 +21,7 @@
 #include <utility>
 
 #include "dynid/mesh/error.hpp"
+#include "internal/mat_reader.hpp"
 
 namespace dynid::internal {
 
@@ -365,13 +364,13 @@ std::vector<unsigned char> inflate_from(std::ifstream& in, std::uint64_t offset,
 
 }  // namespace
 
-bool MatV5Reader::is_v5(const std::string& path) {
+unsigned mat_header_version(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   unsigned char h[128];
-  if (!in.read(reinterpret_cast<char*>(h), 128)) return false;
+  if (!in.read(reinterpret_cast<char*>(h), 128)) return 0;
   const bool little = h[126] == 'I' && h[127] == 'M', big = h[126] == 'M' && h[127] == 'I';
-  const unsigned version = little ? (h[125] << 8 | h[124]) : (h[124] << 8 | h[125]);
-  return (little || big) && version == 0x0100;
+  if (!little && !big) return 0;
+  return little ? (h[125] << 8 | h[124]) : (h[124] << 8 | h[125]);
 }
 
 MatV5Reader::MatV5Reader(std::string path) : path_(std::move(path)) {

@@ -69,8 +69,11 @@ def savemat73(path, variables):
 
 
 def savemat(path, variables, version):
-    """version: "v5" (as SciPy writes by default), "v5z" (v5 with each variable deflated: MATLAB's -v7) or "v7.3"."""
-    if version in ("v5", "v5z"):
+    """version: "v5" (as SciPy writes by default), "v5z" (v5 with each variable deflated: MATLAB's -v7), "v4" (MATLAB's
+    -v4: matrices, text and sparse matrices only) or "v7.3"."""
+    if version == "v4":
+        scipy.io.savemat(path, variables, format="4")
+    elif version in ("v5", "v5z"):
         def cell(v):  # a list is a cell array (n x 1), an object array for SciPy
             a = np.empty((len(v), 1), dtype=object)
             for k, x in enumerate(v):
@@ -106,7 +109,7 @@ def frame_mats(paper_frame):
     return K, M, groups, dofs, nodes
 
 
-@pytest.mark.parametrize("version", ["v5", "v5z", "v7.3"])
+@pytest.mark.parametrize("version", ["v5", "v5z", "v4", "v7.3"])
 @pytest.mark.parametrize("storage", ["sparse", "dense"])
 def test_matrix_model_from_mat(tmp_path, paper_frame, frame_mats, version, storage):
     K, M, groups, dofs, nodes = frame_mats
@@ -114,7 +117,7 @@ def test_matrix_model_from_mat(tmp_path, paper_frame, frame_mats, version, stora
     path = tmp_path / f"frame-{version}.mat"
     savemat(path, {"K0": conv(K), "M0": conv(M), "Kc": conv(groups["columns"][0]), "Mc": conv(groups["columns"][1]),
                    "Kb": conv(groups["beams"][0]), "Mb": conv(groups["beams"][1]), "DOFS": dofs, "NODES": nodes}, version)
-    assert dynid.mat_version(path) == ("MATLAB 7.3 (HDF5)" if version == "v7.3" else "MATLAB 5.0 (v5/v7)")
+    assert dynid.mat_version(path) == {"v7.3": "MATLAB 7.3 (HDF5)", "v4": "MATLAB 4"}.get(version, "MATLAB 5.0 (v5/v7)")
     # Variables read back exactly.
     Kr = dynid.read_mat(path, "K0", "sparse")
     assert (Kr != K).nnz == 0

@@ -1,6 +1,6 @@
 // A check of every variable of a MATLAB v5 file when MatFile opens it (io/src/mat_v5_check.cpp). Written to protect
 // libmatio, which read v5 files until 2026-11-29 and sizes its allocations by the tags; dynid's own reader
-// (internal/mat_v5_reader.hpp) reads them now, and this walk still runs first: it names the damaged variable and tag
+// (internal/mat_reader.hpp) reads them now, and this walk still runs first: it names the damaged variable and tag
 // before anything is listed, and refuses the layouts libmatio read differently (the reasons below are libmatio's).
 #pragma once
 
@@ -28,12 +28,5 @@ inline double max_inflated_bytes(double packed) { return 1100.0 * packed + 1e6; 
 /// skipped, so that both read the same bytes. `unsupported` (optional) is set when the refusal is of something dynid
 /// does not read rather than of damage.
 std::string v5_damage(const std::string& path, bool* unsupported = nullptr);
-
-/// The same for a MATLAB v4 file, its headers read as libmatio's Mat_VarReadNextInfo4 reads them (byte order from
-/// the type word's thousands digit; signed sizes): no dimension may be negative, and every variable's name and data
-/// (rows x cols x element size, twice when complex) must fit in the bytes the file holds after its 20-byte header
-/// (fuzz_mat, 2026-11-28: a 91-byte file whose second name declares 1 GB, which libmatio allocates and clears before
-/// reading). "" when every variable fits.
-std::string v4_damage(const std::string& path);
 
 }  // namespace dynid::internal

@@ -1,4 +1,4 @@
-// dynid/io/mat_file.hpp -- MATLAB .mat files (v5 / v7 compressed: dynid's own reader; v4 and v7.3 HDF5: libmatio): the
+// dynid/io/mat_file.hpp -- MATLAB .mat files (v5 / v7 compressed and v4: dynid's own readers; v7.3 HDF5: libmatio): the
 // variables a case file names, read as matrices, sparse matrices, numbers and text, and the three things dynid
 // takes from them (docs/matrix-input.md, docs/case-file.md):
 //   a matrix model   K and M (sparse or dense), group matrices, element matrices, the DOF and node tables;
