@@ -22,6 +22,7 @@
 
 namespace dynid {
 
+using internal::dims_text;
 using internal::MatArray;
 
 namespace {
@@ -73,12 +74,6 @@ std::vector<std::size_t> dims_of(const matvar_t* v) {
   std::vector<std::size_t> d;
   for (int k = 0; k < v->rank && v->dims; ++k) d.push_back(v->dims[k]);
   return d;
-}
-
-std::string dims_text(const std::vector<std::size_t>& dims) {
-  std::string s;
-  for (std::size_t d : dims) s += (s.empty() ? "" : " x ") + std::to_string(d);
-  return s.empty() ? "0 x 0" : s;
 }
 
 // Number of elements, or -1 when the product exceeds `max` (ReaderLimits::max_mat_elements), or one dimension does:

@@ -7,7 +7,6 @@
 // last row is [rows columns 0]. Every size is checked against the bytes the file holds before anything is read.
 #include <algorithm>
 #include <cstdint>
-#include <cstring>
 #include <fstream>
 #include <tuple>
 #include <utility>
@@ -19,35 +18,22 @@ namespace dynid::internal {
 
 namespace {
 
-std::uint32_t word(const unsigned char* p, bool swap) {
-  std::uint32_t v;
-  std::memcpy(&v, p, 4);
-  return swap ? __builtin_bswap32(v) : v;
-}
-
 // Value k of data of precision `p` (0..5), as a double.
 double value(const unsigned char* data, int p, std::uint64_t k, bool swap) {
-  const std::uint64_t size = v4_value_bytes(p);
-  unsigned char b[8];
-  std::memcpy(b, data + k * size, size);
-  if (swap) std::reverse(b, b + size);
-  const auto as = [&b](auto zero) {
-    std::memcpy(&zero, b, sizeof zero);
-    return static_cast<double>(zero);
-  };
+  const unsigned char* at = data + k * v4_value_bytes(p);
   switch (p) {
     case 0:
-      return as(double{});
+      return load_as_double<double>(at, swap);
     case 1:
-      return as(float{});
+      return load_as_double<float>(at, swap);
     case 2:
-      return as(std::int32_t{});
+      return load_as_double<std::int32_t>(at, swap);
     case 3:
-      return as(std::int16_t{});
+      return load_as_double<std::int16_t>(at, swap);
     case 4:
-      return as(std::uint16_t{});
+      return load_as_double<std::uint16_t>(at, swap);
     default:
-      return as(std::uint8_t{});
+      return load_as_double<std::uint8_t>(at, swap);
   }
 }
 
@@ -66,8 +52,8 @@ std::uint64_t v4_value_bytes(int p) {
 }
 
 bool read_v4_header(const unsigned char* h, V4Header* out) {
-  auto mopt = static_cast<std::int32_t>(word(h, false));
-  if (mopt < 0 || mopt > 4052) mopt = static_cast<std::int32_t>(word(h, true));
+  auto mopt = static_cast<std::int32_t>(load_u32(h, false));
+  if (mopt < 0 || mopt > 4052) mopt = static_cast<std::int32_t>(load_u32(h, true));
   if (mopt < 0 || mopt > 4052) return false;
   const int machine = mopt / 1000, o = (mopt / 100) % 10;
   out->type = static_cast<std::uint32_t>(mopt);
@@ -76,10 +62,10 @@ bool read_v4_header(const unsigned char* h, V4Header* out) {
   if (machine > 1 || o != 0 || out->kind > 2) return false;  // VAX and Cray formats, or no v4 type word
   constexpr bool kHostBigEndian = __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__;
   out->swap = (machine == 1) != kHostBigEndian;
-  out->rows = static_cast<std::int32_t>(word(h + 4, out->swap));
-  out->cols = static_cast<std::int32_t>(word(h + 8, out->swap));
-  out->imaginary = word(h + 12, false) != 0;
-  out->name_length = static_cast<std::int32_t>(word(h + 16, out->swap));
+  out->rows = static_cast<std::int32_t>(load_u32(h + 4, out->swap));
+  out->cols = static_cast<std::int32_t>(load_u32(h + 8, out->swap));
+  out->imaginary = load_u32(h + 12, false) != 0;
+  out->name_length = static_cast<std::int32_t>(load_u32(h + 16, out->swap));
   return !(out->imaginary && out->kind == 1) && out->name_length >= 1;
 }
 

@@ -19,6 +19,8 @@
 #include <iterator>
 #include <string>
 
+#include "internal/mat_reader.hpp"
+
 namespace dynid::internal {
 
 namespace {
@@ -109,16 +111,10 @@ struct Tag {
   std::array<unsigned char, 4> inline_data{};
 };
 
-std::uint32_t u32(const unsigned char* p, bool swap) {
-  std::uint32_t v;
-  std::memcpy(&v, p, 4);
-  return swap ? __builtin_bswap32(v) : v;
-}
-
 bool read_tag(Source& s, bool swap, Tag* t) {
   unsigned char b[8];
   if (!s.read(b, 8)) return false;
-  const std::uint32_t first = u32(b, swap);
+  const std::uint32_t first = load_u32(b, swap);
   if (first >> 16) {
     t->small = true;
     t->type = first & 0xFFFF;
@@ -128,7 +124,7 @@ bool read_tag(Source& s, bool swap, Tag* t) {
   } else {
     t->small = false;
     t->type = first;
-    t->bytes = u32(b + 4, swap);
+    t->bytes = load_u32(b + 4, swap);
     t->stored = (t->bytes + 7) / 8 * 8;
   }
   return true;
@@ -167,7 +163,7 @@ class ArrayWalk {
     if (over(flags, left)) return who + declares("array flags", flags, left);
     unsigned char fb[8];
     if (!s_.read(fb, 8) || !pass(&left, flags, 8)) return cut(who);
-    const std::uint32_t word = u32(fb, swap_);
+    const std::uint32_t word = load_u32(fb, swap_);
     if (!next(&left, &dims)) return cut(who);
     if (over(dims, left)) return who + declares("dimensions", dims, left);
     // From here on the walk must read what libmatio reads: it takes dims.bytes / 4 dimensions and a name only from
@@ -225,7 +221,7 @@ class ArrayWalk {
   // Reads the dimensions `dims` declares (fitting in the array: checked) into their product and text.
   bool read_dims(std::uint64_t* left, const Tag& dims, Count* n) {
     const auto add = [&](const unsigned char* p) {
-      const std::uint32_t d = u32(p, swap_);
+      const std::uint32_t d = load_u32(p, swap_);
       n->elements *= d;
       n->shape += (n->shape.empty() ? "" : " x ") + std::to_string(d);
     };
@@ -299,7 +295,7 @@ class ArrayWalk {
     if (!next(left, &t)) return stop();
     // libmatio takes any tag whose second word is 0 as an empty element and reads on (a walk that stopped there
     // would leave the next elements unchecked); any other tag that is not miMATRIX ends its reading.
-    if ((t.small ? u32(t.inline_data.data(), swap_) : t.bytes) == 0) return "";
+    if ((t.small ? load_u32(t.inline_data.data(), swap_) : t.bytes) == 0) return "";
     if (t.small || t.type != kMiMatrix) return stop();
     if (over(t, *left))
       return who + ": its array element declares " + std::to_string(t.bytes) +
@@ -344,7 +340,7 @@ class ArrayWalk {
     // libmatio reads the field name length as a tag and one word, whatever the tag declares, and stops at 0.
     if (!t.small || t.type != kMiInt32 || t.bytes != 4)
       return who + ": its field name length is not one 32-bit integer";
-    const std::uint32_t length = u32(t.inline_data.data(), swap_);
+    const std::uint32_t length = load_u32(t.inline_data.data(), swap_);
     if (length == 0 || !next(left, &t)) return stop();
     if (over(t, *left)) return who + declares("field names", t, *left);
     // libmatio reads as many whole names as the tag holds and then its padding, not the tag's padded size.

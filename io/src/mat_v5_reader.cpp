@@ -48,12 +48,6 @@ struct Damage : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-std::uint32_t u32(const unsigned char* p, bool swap) {
-  std::uint32_t v;
-  std::memcpy(&v, p, 4);
-  return swap ? __builtin_bswap32(v) : v;
-}
-
 // Bytes [p, p + n) of one array, read front to back.
 struct Span {
   const unsigned char* p;
@@ -74,7 +68,7 @@ struct Element {
 Element next(Span* s, bool swap, const std::string& who, const std::string& what) {
   if (s->n < 8)
     throw Damage(who + ": its " + what + " are missing (its array ends " + std::to_string(s->n) + " bytes on)");
-  const std::uint32_t first = u32(s->p, swap);
+  const std::uint32_t first = load_u32(s->p, swap);
   Element e;
   if (first >> 16) {  // small element: count in the upper half, data in the tag's second word
     e.type = first & 0xFFFF;
@@ -87,7 +81,7 @@ Element next(Span* s, bool swap, const std::string& who, const std::string& what
     return e;
   }
   e.type = first;
-  e.bytes = u32(s->p + 4, swap);
+  e.bytes = load_u32(s->p + 4, swap);
   if (e.bytes > s->n - 8)
     throw Damage(who + ": its " + what + " declare " + std::to_string(e.bytes) + " bytes where the array holds " +
                  std::to_string(s->n - 8));
@@ -104,35 +98,28 @@ std::uint64_t value_size(std::uint32_t type) {
 
 // Value k of numeric data of MAT-file type `type`, as a double.
 double value(const unsigned char* data, std::uint32_t type, std::uint64_t k, bool swap) {
-  const std::uint64_t size = value_size(type);
-  unsigned char b[8];
-  std::memcpy(b, data + k * size, size);
-  if (swap) std::reverse(b, b + size);
-  const auto as = [&b](auto zero) {
-    std::memcpy(&zero, b, sizeof zero);
-    return static_cast<double>(zero);
-  };
+  const unsigned char* p = data + k * value_size(type);
   switch (type) {
     case 1:
-      return as(std::int8_t{});
+      return load_as_double<std::int8_t>(p, swap);
     case 2:
-      return as(std::uint8_t{});
+      return load_as_double<std::uint8_t>(p, swap);
     case 3:
-      return as(std::int16_t{});
+      return load_as_double<std::int16_t>(p, swap);
     case 4:
-      return as(std::uint16_t{});
+      return load_as_double<std::uint16_t>(p, swap);
     case 5:
-      return as(std::int32_t{});
+      return load_as_double<std::int32_t>(p, swap);
     case 6:
-      return as(std::uint32_t{});
+      return load_as_double<std::uint32_t>(p, swap);
     case 7:
-      return as(float{});
+      return load_as_double<float>(p, swap);
     case 9:
-      return as(double{});
+      return load_as_double<double>(p, swap);
     case 12:
-      return as(std::int64_t{});
+      return load_as_double<std::int64_t>(p, swap);
     default:
-      return as(std::uint64_t{});  // 13
+      return load_as_double<std::uint64_t>(p, swap);  // 13
   }
 }
 
@@ -171,11 +158,7 @@ long double element_count(const MatArray& a) {
   return n;
 }
 
-std::string shape_of(const MatArray& a) {
-  std::string s;
-  for (std::size_t d : a.dims) s += (s.empty() ? "" : " x ") + std::to_string(d);
-  return s.empty() ? "0 x 0" : s;
-}
+std::string shape_of(const MatArray& a) { return dims_text(a.dims); }
 
 // A char array's text as UTF-16 code units (MATLAB's char), `count` of them: 16-bit values are units; miUTF8 is
 // decoded, and 32-bit values are code points; 8-bit values are Latin-1. Writers count a text's characters in code
@@ -209,7 +192,7 @@ std::vector<std::uint32_t> text_of(const Element& e, bool swap, const std::strin
         std::memcpy(&h, e.data + k, 2);
         c = swap ? __builtin_bswap16(h) : h;
       } else if (size == 4) {
-        c = u32(e.data + k, swap);
+        c = load_u32(e.data + k, swap);
       }
       codes.push_back(c);
     }
@@ -245,7 +228,7 @@ MatArray header(Span* s, bool swap, std::string who, std::uint32_t* cls, bool* l
   MatArray a;
   const Element flags = next(s, swap, who, "array flags");
   if (flags.bytes != 8) throw Damage(who + ": its array flags are not the two 32-bit words a MAT-file holds");
-  const std::uint32_t word = u32(flags.data, swap);
+  const std::uint32_t word = load_u32(flags.data, swap);
   *cls = word & 0xFF;
   *logical = word & kLogicalFlag;
   a.complex = word & kComplexFlag;
@@ -257,7 +240,7 @@ MatArray header(Span* s, bool swap, std::string who, std::uint32_t* cls, bool* l
     throw Damage(who + ": its dimensions are not 32-bit integers (type " + std::to_string(dims.type) + ", " +
                  std::to_string(dims.bytes) + " bytes)");
   for (std::uint64_t k = 0; k < dims.bytes; k += 4) {
-    const auto d = static_cast<std::int32_t>(u32(dims.data + k, swap));
+    const auto d = static_cast<std::int32_t>(load_u32(dims.data + k, swap));
     if (d < 0)
       throw Damage(who + ": its dimension " + std::to_string(k / 4 + 1) + " is negative (" + std::to_string(d) + ")");
     a.dims.push_back(static_cast<std::size_t>(d));
@@ -364,6 +347,12 @@ std::vector<unsigned char> inflate_from(std::ifstream& in, std::uint64_t offset,
 
 }  // namespace
 
+std::string dims_text(const std::vector<std::size_t>& dims) {
+  std::string s;
+  for (std::size_t d : dims) s += (s.empty() ? "" : " x ") + std::to_string(d);
+  return s.empty() ? "0 x 0" : s;
+}
+
 unsigned mat_header_version(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   unsigned char h[128];
@@ -386,7 +375,7 @@ MatV5Reader::MatV5Reader(std::string path) : path_(std::move(path)) {
     in.seekg(static_cast<std::streamoff>(pos));
     unsigned char tag[8];
     if (!in.read(reinterpret_cast<char*>(tag), 8)) break;
-    const std::uint32_t type = u32(tag, swap_), bytes = u32(tag + 4, swap_);
+    const std::uint32_t type = load_u32(tag, swap_), bytes = load_u32(tag + 4, swap_);
     if (type >> 16) break;  // a small element at the top level: no more variables
     Entry e{pos + 8, std::min<std::uint64_t>(bytes, file_size - pos - 8), type == kMiCompressed};
     const std::string who = "the variable at byte " + std::to_string(pos);
@@ -396,7 +385,7 @@ MatV5Reader::MatV5Reader(std::string path) : path_(std::move(path)) {
     std::string broken;
     if (e.compressed) {
       head = inflate_from(in, e.offset, e.bytes, kHeaderBytes + 8, &broken);
-      if (head.size() < 8 || u32(head.data(), swap_) != kMiMatrix) continue;  // no array inside: not a variable
+      if (head.size() < 8 || load_u32(head.data(), swap_) != kMiMatrix) continue;  // no array inside: not a variable
       head.erase(head.begin(), head.begin() + 8);
     } else {
       head.resize(std::min<std::uint64_t>(e.bytes, kHeaderBytes));
@@ -424,7 +413,7 @@ MatArray MatV5Reader::read(std::size_t k) const {
   std::string broken;
   if (e.compressed) {
     std::vector<unsigned char> tag = inflate_from(in, e.offset, e.bytes, 8, &broken);
-    const std::uint64_t declared = tag.size() == 8 ? u32(tag.data() + 4, swap_) : 0;
+    const std::uint64_t declared = tag.size() == 8 ? load_u32(tag.data() + 4, swap_) : 0;
     data = inflate_from(in, e.offset, e.bytes, 8 + declared, &broken);
     data.erase(data.begin(), data.begin() + std::min<std::size_t>(8, data.size()));
     // A stream that ends cleanly ends the array, whatever its tag declared: libmatio 1.5.23 declares a compressed

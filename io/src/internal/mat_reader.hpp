@@ -2,11 +2,34 @@
 // and the array they and libmatio's v7.3 (HDF5) path hand to MatFile (io/src/mat_file.cpp).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
 namespace dynid::internal {
+
+/// The 32-bit word at `p`, byte-swapped when `swap` (the file's byte order is not this machine's).
+inline std::uint32_t load_u32(const unsigned char* p, bool swap) {
+  std::uint32_t v;
+  std::memcpy(&v, p, 4);
+  return swap ? __builtin_bswap32(v) : v;
+}
+
+/// The value of type T stored at `p` (byte-swapped when `swap`), as a double.
+template <class T>
+double load_as_double(const unsigned char* p, bool swap) {
+  unsigned char b[sizeof(T)];
+  std::memcpy(b, p, sizeof(T));
+  if (swap) std::reverse(b, b + sizeof(T));
+  T v;
+  std::memcpy(&v, b, sizeof(T));
+  return static_cast<double>(v);
+}
+
+/// "2 x 3" ("0 x 0" for no dimensions): an array's dimensions in messages.
+std::string dims_text(const std::vector<std::size_t>& dims);
 
 /// One MATLAB array as dynid reads it. Every size here was counted from the bytes the file holds, never taken from a
 /// declared size alone.
