@@ -140,6 +140,23 @@ std::size_t CompareWithLibmatio(const std::string& path) {
   return compared;
 }
 
+// Writes the real sparse matrix `name` (rows x cols; 0-based row indices `ir`, column pointers `jc`) with libmatio.
+void PutSparse(mat_t* m, const char* name, std::size_t rows, std::size_t cols, std::vector<mat_uint32_t> ir,
+               std::vector<mat_uint32_t> jc, std::vector<double> values, matio_compression z) {
+  mat_sparse_t sparse{};
+  sparse.nzmax = sparse.nir = sparse.ndata = static_cast<mat_uint32_t>(values.size());
+  sparse.ir = ir.data();
+  sparse.jc = jc.data();
+  sparse.njc = static_cast<mat_uint32_t>(jc.size());
+  sparse.data = values.data();
+  std::size_t dims[2] = {rows, cols};
+  matvar_t* v = Mat_VarCreate(name, MAT_C_SPARSE, MAT_T_DOUBLE, 2, dims, &sparse, MAT_F_DONT_COPY_DATA);
+  ASSERT_NE(v, nullptr);
+  EXPECT_EQ(Mat_VarWrite(m, v, z), 0);
+  v->data = nullptr;  // the arrays are this function's
+  Mat_VarFree(v);
+}
+
 // Writes with libmatio a v5 file holding every class dynid reads.
 void WriteWithLibmatio(const std::string& path, matio_compression compression) {
   const MatPtr m(Mat_CreateVer(path.c_str(), nullptr, MAT_FT_MAT5));
@@ -149,7 +166,7 @@ void WriteWithLibmatio(const std::string& path, matio_compression compression) {
     EXPECT_EQ(Mat_VarWrite(m.get(), v, compression), 0);
     Mat_VarFree(v);
   };
-  std::size_t d23[2] = {2, 3}, d15[2] = {1, 5}, d11[2] = {1, 1}, d00[2] = {0, 0}, d33[2] = {3, 3}, d12[2] = {1, 2};
+  std::size_t d23[2] = {2, 3}, d15[2] = {1, 5}, d11[2] = {1, 1}, d00[2] = {0, 0}, d12[2] = {1, 2};
   double a[6] = {1.5, -2, 3e-300, 4e300, 0, -0.25};
   put(Mat_VarCreate("a", MAT_C_DOUBLE, MAT_T_DOUBLE, 2, d23, a, 0));
   float f[5] = {1.25f, -7, 3.5e30f, 0, 1e-30f};
@@ -172,17 +189,7 @@ void WriteWithLibmatio(const std::string& path, matio_compression compression) {
   char text[] = "1u2u3r";  // 2 x 3: "123" and "uur" read column-major
   put(Mat_VarCreate("t", MAT_C_CHAR, MAT_T_UINT8, 2, d23, text, 0));
   // A 3 x 3 sparse matrix with an empty column: (1,1) 4, (3,1) -1, (2,3) 2.5.
-  mat_uint32_t ir[3] = {0, 2, 1}, jc[4] = {0, 2, 2, 3};
-  double sv[3] = {4, -1, 2.5};
-  mat_sparse_t sparse{};
-  sparse.nzmax = 3;
-  sparse.ir = ir;
-  sparse.nir = 3;
-  sparse.jc = jc;
-  sparse.njc = 4;
-  sparse.ndata = 3;
-  sparse.data = sv;
-  put(Mat_VarCreate("K", MAT_C_SPARSE, MAT_T_DOUBLE, 2, d33, &sparse, 0));
+  PutSparse(m.get(), "K", 3, 3, {0, 2, 1}, {0, 2, 2, 3}, {4, -1, 2.5}, compression);
   // A cell array of two matrices: libmatio frees the cells with the cell array.
   double c1[2] = {1, 2}, c2[1] = {3};
   matvar_t* cells[2] = {Mat_VarCreate(nullptr, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, d12, c1, 0),
@@ -217,7 +224,7 @@ void WriteV4WithLibmatio(const std::string& path) {
     EXPECT_EQ(Mat_VarWrite(m.get(), v, MAT_COMPRESSION_NONE), 0);
     Mat_VarFree(v);
   };
-  std::size_t d23[2] = {2, 3}, d15[2] = {1, 5}, d00[2] = {0, 0}, d33[2] = {3, 3};
+  std::size_t d23[2] = {2, 3}, d15[2] = {1, 5}, d00[2] = {0, 0};
   double a[6] = {1.5, -2, 3e-300, 4e300, 0, -0.25};
   put(Mat_VarCreate("a", MAT_C_DOUBLE, MAT_T_DOUBLE, 2, d23, a, 0));
   float f[5] = {1.25f, -7, 3.5e30f, 0, 1e-30f};
@@ -233,17 +240,7 @@ void WriteV4WithLibmatio(const std::string& path) {
   put(Mat_VarCreate("e", MAT_C_DOUBLE, MAT_T_DOUBLE, 2, d00, nullptr, 0));
   char text[] = "1u2u3r";
   put(Mat_VarCreate("t", MAT_C_CHAR, MAT_T_UINT8, 2, d23, text, 0));
-  mat_uint32_t ir[3] = {0, 2, 1}, jc[4] = {0, 2, 2, 3};
-  double sv[3] = {4, -1, 2.5};
-  mat_sparse_t sparse{};
-  sparse.nzmax = 3;
-  sparse.ir = ir;
-  sparse.nir = 3;
-  sparse.jc = jc;
-  sparse.njc = 4;
-  sparse.ndata = 3;
-  sparse.data = sv;
-  put(Mat_VarCreate("K", MAT_C_SPARSE, MAT_T_DOUBLE, 2, d33, &sparse, 0));
+  PutSparse(m.get(), "K", 3, 3, {0, 2, 1}, {0, 2, 2, 3}, {4, -1, 2.5}, MAT_COMPRESSION_NONE);
 }
 
 TEST(MatV4Reader, AgreesWithLibmatioOnFilesLibmatioWrote) {
@@ -308,24 +305,10 @@ TEST(MatFileLimits, ASparseMatrixCountsItsRowsAndColumnsNotItsDenseSize) {
     {
       const MatPtr m(Mat_CreateVer(path.c_str(), nullptr, version));
       ASSERT_TRUE(m);
-      std::vector<mat_uint32_t> ir = {0, 99999}, jc(100001, 1);
+      std::vector<mat_uint32_t> jc(100001, 1);
       jc[0] = 0;
       jc[100000] = 2;
-      double values[2] = {3, 4};
-      mat_sparse_t sparse{};
-      sparse.nzmax = 2;
-      sparse.ir = ir.data();
-      sparse.nir = 2;
-      sparse.jc = jc.data();
-      sparse.njc = 100001;
-      sparse.ndata = 2;
-      sparse.data = values;
-      std::size_t dims[2] = {100000, 100000};
-      matvar_t* v = Mat_VarCreate("K", MAT_C_SPARSE, MAT_T_DOUBLE, 2, dims, &sparse, MAT_F_DONT_COPY_DATA);
-      ASSERT_NE(v, nullptr);
-      EXPECT_EQ(Mat_VarWrite(m.get(), v, MAT_COMPRESSION_NONE), 0);
-      v->data = nullptr;  // the arrays are the test's
-      Mat_VarFree(v);
+      PutSparse(m.get(), "K", 100000, 100000, {0, 99999}, jc, {3, 4}, MAT_COMPRESSION_NONE);
     }
     const SparseMatrix K = MatFile(path).sparse("K", "stiffness");
     EXPECT_EQ(K.rows(), 100000);
