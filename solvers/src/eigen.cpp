@@ -591,6 +591,9 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
         const Eigen::VectorXd& th = lr.theta;  // descending theta = ascending lambda
         ev.resize(th.size());
         V = std::move(lr.Y);
+        // An invariant subspace with no fresh direction left ends the run without Ritz vectors (lr.Y empty):
+        // no modes, not converged, reported as such rather than as an internal error.
+        if (V.rows() != n) V.resize(n, 0);
         F.backward_block(V, &V);  // in place: the Ritz vectors' storage becomes the modes' (B may be X)
         for (Eigen::Index k = 0; k < th.size(); ++k) {
           ev[k] = sigma + 1.0 / th[k];
