@@ -556,6 +556,7 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
     Yr = Eigen::HouseholderQR<Eigen::MatrixXd>(Yr).householderQ() * Eigen::MatrixXd::Identity(n, r);
   }
   bool converged = true;
+  bool exhausted = false;  // the Lanczos basis spanned the operator's whole range
   if (nev > 0) {
     auto tl = Clock::now();
     const int n_eff = static_cast<int>(n - r);
@@ -587,12 +588,13 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
                                           detail::LanczosOptions{want, ncv, opt.max_restarts, opt.tolerance});
         sum.solves += op.count();
         sum.restarts += lr.restarts;
-        ok = lr.converged;
+        // A range with fewer dimensions than wanted (fewer massive DOFs): every finite mode, as the dense path.
+        ok = lr.converged || lr.exhausted;
+        exhausted = lr.exhausted;
         const Eigen::VectorXd& th = lr.theta;  // descending theta = ascending lambda
         ev.resize(th.size());
         V = std::move(lr.Y);
-        // An invariant subspace with no fresh direction left ends the run without Ritz vectors (lr.Y empty):
-        // no modes, not converged, reported as such rather than as an internal error.
+        // A run the operator broke off returns no Ritz vectors (lr.Y empty): no modes, not converged.
         if (V.rows() != n) V.resize(n, 0);
         F.backward_block(V, &V);  // in place: the Ritz vectors' storage becomes the modes' (B may be X)
         for (Eigen::Index k = 0; k < th.size(); ++k) {
@@ -698,6 +700,11 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
                   std::to_string(band_count);
   }
   sum.status = converged ? EigenStatus::kSuccess : EigenStatus::kNotConverged;
+  // The Krylov space closed with no fresh direction left: every other eigenvalue is infinite (massless
+  // directions) or more than 1e8 times farther from the shift than the lowest (nearly massless ones).
+  if (converged && exhausted && m < opt.num_modes)
+    sum.message = "the model has only " + std::to_string(m) +
+                  " finite modes (the others belong to massless or nearly massless DOFs)";
   cache_->llt_valid = !band && nev > 0;  // F holds K - sigma M (LL^T)
   report(opt, "done", 1.0);
   return sol;

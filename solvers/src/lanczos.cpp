@@ -79,9 +79,12 @@ LanczosResult thick_restart_lanczos(const std::function<void(const double* x, do
   if (!(beta > 0)) return out;
   V.col(0) = v0 / beta;
   int k = 0;  // kept Ritz vectors at the start of the sweep
+  // Basis columns in use: m, or fewer once the basis spans the operator's whole range (no fresh direction is
+  // left, e.g. a mass matrix with fewer massive DOFs than m): T is then exact and every Ritz pair converged.
+  int active = m;
   for (out.restarts = 0; out.restarts <= o.max_restarts; ++out.restarts) {
     // Extend the basis from column k to m: T = V^T A V as the passes compute it.
-    for (int j = k; j < m; ++j) {
+    for (int j = k; j < active; ++j) {
       op(V.col(j).data(), w.data());
       // The three-term recurrence first (cheap: two vectors), so that the pass over the whole basis removes only
       // the rounding's loss of orthogonality and one pass suffices (DGKS); the first step after a restart couples
@@ -102,31 +105,35 @@ LanczosResult thick_restart_lanczos(const std::function<void(const double* x, do
       if (j + 1 == m) break;
       if (negligible(beta)) {  // an invariant subspace
         beta = 0;
-        if (!fresh(j + 1)) return out;
+        if (!fresh(j + 1)) {
+          active = j + 1;
+          break;
+        }
       } else {
         V.col(j + 1) = w / beta;
       }
       T(j + 1, j) = T(j, j + 1) = beta;
     }
     // w: the residual direction, norm beta (untouched until the restart below)
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(T);
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(T.topLeftCorner(active, active));
     // Descending Ritz values and their coordinates.
     Eigen::VectorXd theta = es.eigenvalues().reverse();
     Eigen::MatrixXd Yt = es.eigenvectors().rowwise().reverse();
-    const double tmax = std::max(std::abs(theta[0]), std::abs(theta[m - 1]));
+    const double tmax = std::max(std::abs(theta[0]), std::abs(theta[active - 1]));
+    const int wanted = std::min(nev, active);  // an exhausted range may hold fewer than nev
     int nconv = 0;
-    std::vector<char> conv(static_cast<std::size_t>(nev), 0);
-    for (int i = 0; i < nev; ++i) {
-      const double resid = std::abs(beta * Yt(m - 1, i));
+    std::vector<char> conv(static_cast<std::size_t>(wanted), 0);
+    for (int i = 0; i < wanted; ++i) {
+      const double resid = std::abs(beta * Yt(active - 1, i));
       if (resid <= o.tolerance * std::max(std::abs(theta[i]), eps23 * tmax))
         conv[static_cast<std::size_t>(i)] = 1, ++nconv;
     }
-    if (nconv == nev || out.restarts == o.max_restarts) {
+    if (nconv == nev || out.restarts == o.max_restarts || active < m) {
       std::vector<int> keep;
-      for (int i = 0; i < nev; ++i)
+      for (int i = 0; i < wanted; ++i)
         if (conv[static_cast<std::size_t>(i)]) keep.push_back(i);
       out.theta.resize(static_cast<Eigen::Index>(keep.size()));
-      Eigen::MatrixXd Ys(m, static_cast<Eigen::Index>(keep.size()));
+      Eigen::MatrixXd Ys(active, static_cast<Eigen::Index>(keep.size()));
       for (std::size_t q = 0; q < keep.size(); ++q) {
         out.theta[static_cast<Eigen::Index>(q)] = theta[keep[q]];
         Ys.col(static_cast<Eigen::Index>(q)) = Yt.col(keep[q]);
@@ -135,6 +142,7 @@ LanczosResult thick_restart_lanczos(const std::function<void(const double* x, do
       V.conservativeResize(n, Ys.cols());
       out.Y = std::move(V);
       out.converged = nconv == nev;
+      out.exhausted = active < m;
       return out;
     }
     // Thick restart: keep the best k Ritz vectors and continue from the residual.
@@ -146,8 +154,9 @@ LanczosResult thick_restart_lanczos(const std::function<void(const double* x, do
       T(i, k) = T(k, i) = beta * Yt(m - 1, i);
     }
     if (negligible(beta)) {
+      beta = 0;
       for (int i = 0; i < k; ++i) T(i, k) = T(k, i) = 0;
-      if (!fresh(k)) return out;
+      if (!fresh(k)) active = k;  // the kept Ritz vectors span the whole range: the next sweep only returns them
     } else {
       V.col(k) = w / beta;
     }

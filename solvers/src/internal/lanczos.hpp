@@ -18,6 +18,10 @@ struct LanczosResult {
   Eigen::MatrixXd Y;      ///< their Ritz vectors (n x theta.size()), orthonormal
   int restarts = 0;
   bool converged = false;  ///< all nev converged
+  /// The basis came to span the operator's whole range (no fresh direction left: random vectors through the
+  /// operator keep less than 1e-8 of their norm outside it): every pair is exact, and theta holds all of them
+  /// when the range has fewer than nev dimensions (e.g. fewer massive DOFs).
+  bool exhausted = false;
 };
 
 /// Thick-restart Lanczos (Wu & Simon, SIAM J. Matrix Anal. Appl. 22, 2000) for the nev largest eigenvalues of
