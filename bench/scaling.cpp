@@ -225,8 +225,8 @@ int DistributedTable(const std::vector<Spec>& specs, const std::string& only, co
     const json d = RunJson(self + " --child " + std::to_string(k) + " run", 3600);
     const json p = RunJson(mpi + self + " --child " + std::to_string(k) + " mpi", 3600);
     if (p.contains("error")) {
-      std::cout << "| " << s.name << " | local: " << d.value("error", "ok") << ", distributed: " << p.value("error", "ok")
-                << " |" << std::endl;
+      std::cout << "| " << s.name << " | local: " << d.value("error", "ok")
+                << ", distributed: " << p.value("error", "ok") << " |" << std::endl;
       continue;
     }
     // A model too large for one process (the 10^6-DOF cubic frame) still gets its distributed row; the comparison
@@ -238,12 +238,14 @@ int DistributedTable(const std::vector<Spec>& specs, const std::string& only, co
     const double fill = p["factor_entries"].get<double>() / p["nnz"].get<double>();
     std::cout << "| " << s.name << " | " << p["dofs"] << " | " << ranks << " | "
               << (local ? Fmt(d["total_s"]) : d.value("error", "")) << " | "
-              << (local ? Fmt(d["peak_rss_mb"], "%.0f") : "-") << " | " << Fmt(p["total_s"]) << " (" << Fmt(p["factorize_s"]) << " / "
-              << Fmt(p["lanczos_s"]) << ") | " << per_rank << " | " << Fmt(p["factor_entries"].get<double>(), "%.3g")
-              << " (" << Fmt(fill, "%.1f") << ") | " << Fmt(p["factor_gflop"], "%.0f") << " | "
-              << p["mumps_mb_max_rank"] << " / " << p["mumps_mb_total"] << " | " << Fmt(p["petsc_sent_mb"], "%.1f")
-              << " (" << Fmt(p["petsc_messages"], "%.0f") << ") | " << p["solves"] << " | "
-              << (local ? Fmt(MaxRelDiff(d, p), "%.1e") : "- (largest eigen-residual " + Fmt(p["max_residual"], "%.1e") + ")")
+              << (local ? Fmt(d["peak_rss_mb"], "%.0f") : "-") << " | " << Fmt(p["total_s"]) << " ("
+              << Fmt(p["factorize_s"]) << " / " << Fmt(p["lanczos_s"]) << ") | " << per_rank << " | "
+              << Fmt(p["factor_entries"].get<double>(), "%.3g") << " (" << Fmt(fill, "%.1f") << ") | "
+              << Fmt(p["factor_gflop"], "%.0f") << " | " << p["mumps_mb_max_rank"] << " / " << p["mumps_mb_total"]
+              << " | " << Fmt(p["petsc_sent_mb"], "%.1f") << " (" << Fmt(p["petsc_messages"], "%.0f") << ") | "
+              << p["solves"] << " | "
+              << (local ? Fmt(MaxRelDiff(d, p), "%.1e")
+                        : "- (largest eigen-residual " + Fmt(p["max_residual"], "%.1e") + ")")
               << " |" << std::endl;
   }
   return 0;
