@@ -59,7 +59,10 @@
 // Monte Carlo. A mode overlapped by a neighbour is biased by its tail: sigma_f is widened by sqrt(1 + (o / 0.3)^2),
 // o the mean half-power half-bandwidth of the mode and its nearest identified neighbour over their distance (on
 // the dev split's records, median |z| by the truth's overlap: 0.61 below 0.05, 0.86 at 0.1-0.2, 1.05 at 0.4-0.8,
-// 4.2 above 0.8 before; 0.61-0.78 up to 0.8 after). The shapes keep the split-data std.
+// 4.2 above 0.8 before; 0.61-0.78 up to 0.8 after). The shapes keep the split-data std. A random-force test's
+// modes refined by LSCF (identify_recordings) take instead the split-data value of LSCF on the same halves, as
+// impacts do: with the force measured, their error is about half the stationary value (the paper frame's
+// random-force tests: rms z 0.47 with it, 0.88 with LSCF's halves; tests/test_identify.cpp).
 // Both statistical values are combined in quadrature with a quarter of the mode's spread over the model orders
 // (order_frequency_std_hz): what the halves have in common (an impact record's truncation, the fitted model's
 // order, a neighbour's tail) moves the pole with the order, not between the halves. The halves' spread alone
@@ -265,9 +268,13 @@ ModelBand band_from_model(const Model& model, const std::vector<MeasuredDof>& se
 /// Recordings identified as a whole: "lscf" on FRFs (recordings with force channels; a roving hammer gives one
 /// recording per hit location) or "ssi" (the output channels; records of all recordings concatenated); "" picks
 /// by the data: lscf for impacts (every force record a blow), ssi for continuous records, output-only or with a
-/// random force (broadband: the outputs alone identify the modes, free of the leakage bias Welch FRFs have at
-/// the lowest modes of a wide band). The band and resolution come from plan_identification where the options
-/// leave them open; then the split-data uncertainty (header comment) when options.split_uncertainty.
+/// random force (broadband: the outputs alone select the modes, free of the leakage bias Welch FRFs have at
+/// the lowest modes of a wide band). With a random force, each SSI mode then takes its frequency and damping
+/// from LSCF on the H1 FRFs of the same records where LSCF has the same mode (MAC >= 0.9, within the mode's
+/// half-power half-bandwidth or 0.5 %): the measured force removes the bias SSI's output-only model leaves at
+/// some modes, and those modes' std is LSCF's split-data scatter (header comment). The band and resolution come
+/// from plan_identification where the options leave them open; then the split-data uncertainty (header
+/// comment) when options.split_uncertainty.
 IdentificationSummary identify_recordings(std::vector<Recording> recordings, const std::string& method,
                                           const IdentificationOptions& options);
 /// FRFs identified with LSCF (the band from plan_identification where the options leave it open), with the
