@@ -204,8 +204,8 @@ TEST(Uncertainty, ContinuousRecordsFrequencyStdMatchesTheScatterOverRealisations
 // The same for a random-force test identified with the defaults (identify_recordings: SSI's selection, each
 // mode's frequency and damping from LSCF on the H1 FRFs where LSCF has it): the std is the stationary
 // response's for the modes SSI alone gives, and LSCF's own split-data scatter for the refined ones (their errors
-// are 0.45 times the stationary value here: rms z 0.47 with it). The paper frame, a random force at node 17 ux,
-// 300 s at 25.6 Hz, 8 seeds; the same bounds. 8 of the 9 modes are refined; the lowest, whose half-power
+// are 0.47 times the stationary value here: rms z 0.47 with it). The paper frame, a random force at node 17 ux,
+// 300 s at 25.6 Hz, 8 seeds; the same bounds. Seed 1 has 8 of its 9 modes refined; the lowest, whose half-power
 // bandwidth is half a Welch line of these records, keeps SSI's values.
 TEST(Uncertainty, RandomForceFrequencyStdMatchesTheScatterWithLscfRefinement) {
   const Case c = load_case(test::CasesDir() + "/paper-frame");

@@ -247,7 +247,7 @@ std::vector<char> refine_with_lscf(IdentificationSummary& s, const std::vector<R
 
 // The refined modes' frequency and damping std: LSCF's own scatter, from the halves of the data identified by
 // LSCF (split_uncertainty), in place of the stationary response's (which describes SSI's output-only estimates:
-// with the force measured, LSCF's errors on the paper frame's random-force tests are 0.45 times that value).
+// with the force measured, LSCF's errors on the paper frame's random-force tests are 0.47 times that value).
 void lscf_split_uncertainty(IdentificationSummary& s, const std::vector<char>& refined, const std::vector<Recording>& A,
                             const std::vector<Recording>& B, const IdentificationOptions& io,
                             const IdentificationPlan& plan) {
