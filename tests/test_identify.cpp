@@ -101,6 +101,25 @@ void expect_rms_z_near_one(const std::vector<double>& z2) {
   EXPECT_LE(rms, 1.6);
 }
 
+// The calibration check over independent realisations: virtual tests of `c` with seeds 1..8 (`options` gives
+// everything but the seed), identified by `method` in [lo, hi]; each identification is passed to `check` (seed,
+// summary; a fatal failure there ends the test), then every truth mode's z joins the rms-z bounds above.
+template <class Check>
+void expect_frequency_std_calibrated(const Case& c, Opt options, const std::string& method, double lo, double hi,
+                                     Check check) {
+  const ModalResult modes = all_modes(c.model);
+  std::vector<double> z2;
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    options.seed = seed;
+    const VirtualTest t = simulate_test(c.model, modes, options);
+    const IdentificationSummary id = identify_recordings(t.recordings, method, test::Band(lo, hi));
+    check(seed, id);
+    if (::testing::Test::HasFatalFailure()) return;
+    add_frequency_z2(t.modes, id, lo, hi, z2);
+  }
+  expect_rms_z_near_one(z2);
+}
+
 TEST(VirtualTest, BeamImpactRoundTrip) {
   const Case c = load_case(test::CasesDir() + "/paper-beam");
   Opt o = plan(c.model, Opt::Excitation::kImpact, 2048, 4, 800);
@@ -188,17 +207,11 @@ TEST(VirtualTest, FrameAmbientRoundTrip) {
 // overstated, it would miss real physics. The split-data spread's ratio per mode ranged 0.46-2.7x on the dev split.
 TEST(Uncertainty, ContinuousRecordsFrequencyStdMatchesTheScatterOverRealisations) {
   const Case c = load_case(test::CasesDir() + "/paper-frame");
-  const ModalResult modes = all_modes(c.model);
-  std::vector<double> z2;
-  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
-    Opt o = plan(c.model, Opt::Excitation::kAmbient, 25.6, 300, 10);
-    o.seed = seed;
-    const VirtualTest t = simulate_test(c.model, modes, o);
-    const IdentificationSummary id = identify_recordings(t.recordings, "ssi", test::Band(0.3, 8));
-    EXPECT_NEAR(id.stationary_record_s, 300, 1 / 25.6);  // one record of 300 s (to a sample)
-    add_frequency_z2(t.modes, id, 0.3, 8, z2);
-  }
-  expect_rms_z_near_one(z2);
+  expect_frequency_std_calibrated(c, plan(c.model, Opt::Excitation::kAmbient, 25.6, 300, 10), "ssi", 0.3, 8,
+                                  [](std::uint64_t, const IdentificationSummary& id) {
+                                    EXPECT_NEAR(id.stationary_record_s, 300,
+                                                1 / 25.6);  // one record of 300 s (to a sample)
+                                  });
 }
 
 // The same for a random-force test identified with the defaults (identify_recordings: SSI's selection, each
@@ -209,22 +222,15 @@ TEST(Uncertainty, ContinuousRecordsFrequencyStdMatchesTheScatterOverRealisations
 // bandwidth is half a Welch line of these records, keeps SSI's values.
 TEST(Uncertainty, RandomForceFrequencyStdMatchesTheScatterWithLscfRefinement) {
   const Case c = load_case(test::CasesDir() + "/paper-frame");
-  const ModalResult modes = all_modes(c.model);
-  std::vector<double> z2;
-  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
-    Opt o = plan(c.model, Opt::Excitation::kRandom, 25.6, 300, 10);
-    o.inputs = {{17, Dof::UX}};
-    o.seed = seed;
-    const VirtualTest t = simulate_test(c.model, modes, o);
-    const IdentificationSummary id = identify_recordings(t.recordings, "", test::Band(0.3, 8));
+  Opt o = plan(c.model, Opt::Excitation::kRandom, 25.6, 300, 10);
+  o.inputs = {{17, Dof::UX}};
+  expect_frequency_std_calibrated(c, o, "", 0.3, 8, [](std::uint64_t seed, const IdentificationSummary& id) {
     EXPECT_EQ(id.method, "ssi");
     const std::string refined = "of " + std::to_string(id.modes.size()) + " SSI modes from LSCF";
     EXPECT_TRUE(std::any_of(id.notes.begin(), id.notes.end(),
                             [&](const std::string& n) { return n.find(refined) != std::string::npos; }))
         << "no LSCF refinement (seed " << seed << "): " << ::testing::PrintToString(id.notes);
-    add_frequency_z2(t.modes, id, 0.3, 8, z2);
-  }
-  expect_rms_z_near_one(z2);
+  });
 }
 
 // The same for impacts (identify.hpp: the halves' spread, alternate hits, combined with a quarter of the spread
@@ -234,19 +240,12 @@ TEST(Uncertainty, RandomForceFrequencyStdMatchesTheScatterWithLscfRefinement) {
 // same bounds as above, 0.6 to 1.6.
 TEST(Uncertainty, ImpactFrequencyStdMatchesTheErrorOverRealisations) {
   const Case c = load_case(test::CasesDir() + "/paper-beam");
-  const ModalResult modes = all_modes(c.model);
-  std::vector<double> z2;
-  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
-    Opt o = plan(c.model, Opt::Excitation::kImpact, 2048, 4, 800);
-    o.inputs = {{1, Dof::UY}};
-    o.impacts = 5;
-    o.seed = seed;
-    const VirtualTest t = simulate_test(c.model, modes, o);
-    const IdentificationSummary id = identify_recordings(t.recordings, "lscf", test::Band(20, 700));
+  Opt o = plan(c.model, Opt::Excitation::kImpact, 2048, 4, 800);
+  o.inputs = {{1, Dof::UY}};
+  o.impacts = 5;
+  expect_frequency_std_calibrated(c, o, "lscf", 20, 700, [](std::uint64_t, const IdentificationSummary& id) {
     ASSERT_EQ(id.uncertainty_halves, 2);
-    add_frequency_z2(t.modes, id, 20, 700, z2);
-  }
-  expect_rms_z_near_one(z2);
+  });
 }
 
 // Issue 16, item 3: a cantilever over a wide band (the band top ~100x its first mode) identified with the
