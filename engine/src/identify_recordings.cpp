@@ -251,8 +251,8 @@ std::vector<char> refine_with_lscf(IdentificationSummary& s, const std::vector<R
 void lscf_split_uncertainty(IdentificationSummary& s, const std::vector<char>& refined, const std::vector<Recording>& A,
                             const std::vector<Recording>& B, const IdentificationOptions& io,
                             const IdentificationPlan& plan) {
-  IdentificationSummary t = s;
-  t.notes.clear();
+  IdentificationSummary t;  // the modes alone: split_uncertainty reads nothing else
+  t.modes = s.modes;
   try {
     const IdentificationOptions lo = lscf_options(io);
     split_uncertainty(t, identify_once(A, "lscf", lo, plan), identify_once(B, "lscf", lo, plan));
