@@ -272,7 +272,9 @@ ModelBand band_from_model(const Model& model, const std::vector<MeasuredDof>& se
 /// the lowest modes of a wide band). With a random force, each SSI mode then takes its frequency and damping
 /// from LSCF on the H1 FRFs of the same records where LSCF has the same mode (MAC >= 0.9, within the mode's
 /// half-power half-bandwidth or 0.5 %): the measured force removes the bias SSI's output-only model leaves at
-/// some modes, and those modes' std is LSCF's split-data scatter (header comment). The band and resolution come
+/// some modes, and those modes' std is LSCF's split-data scatter (header comment); where the mode's half-power
+/// bandwidth spans fewer than 4 of the FRFs' lines, LSCF's damping is biased high and SSI's damping and damping
+/// std are kept (LSCF's frequency is still taken). The band and resolution come
 /// from plan_identification where the options leave them open; then the split-data uncertainty (header
 /// comment) when options.split_uncertainty.
 IdentificationSummary identify_recordings(std::vector<Recording> recordings, const std::string& method,
