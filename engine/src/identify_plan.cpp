@@ -207,7 +207,7 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
   // Resolution: refine continuous records while the lowest peak's half-power width spans < 4 lines.
   if (!p.impulsive && !p.peaks_hz.empty()) {
     const int longest = pow2_at_most(static_cast<double>(shortest) / 4);
-    while (segment < longest && !(widths[0] >= 4 * sp.df)) {
+    while (segment < longest && !(widths[0] >= kResolvedLines * sp.df)) {
       segment *= 2;
       sp = channel_spectrum(recs, false, segment, false);
       const std::vector<double> again = peaks_of(sp, &widths);
@@ -251,7 +251,8 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
   } else {
     const int longest = pow2_at_most(static_cast<double>(shortest) / 4);
     double need = static_cast<double>(longest);
-    if (p.lowest_peak_hz > 0 && p.lowest_peak_damping > 0) need = fs / (p.lowest_peak_damping * p.lowest_peak_hz / 2);
+    if (p.lowest_peak_hz > 0 && p.lowest_peak_damping > 0)
+      need = fs / (2 * p.lowest_peak_damping * p.lowest_peak_hz / kResolvedLines);
     int seg = 64;
     while (seg < need && seg < longest) seg *= 2;
     p.segment = std::min(seg, longest);

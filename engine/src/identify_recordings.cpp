@@ -208,11 +208,11 @@ IdentificationOptions lscf_options(IdentificationOptions io) {
 // coloured-input bias SSI's output-only model leaves at some modes (bench/README.md, identification accuracy:
 // dev random-force tests' median damping error 5.3 -> 3.1 %, modes found unchanged; bench/discovery/README.md:
 // dev random-force cases named right 43 -> 55 of 70; test 37 of 55 before and after, parameters within 10 % more
-// often). Returns, per mode, 0 (SSI's values kept), 1 (LSCF's frequency and damping) or 2 (LSCF's frequency, SSI's
-// damping).
-std::vector<char> refine_with_lscf(IdentificationSummary& s, const std::vector<Recording>& recs,
-                                   const IdentificationOptions& io, const IdentificationPlan& plan) {
-  std::vector<char> refined_mode(s.modes.size(), 0);
+// often). Returns, per mode, which of LSCF's values it took.
+enum class Refined : char { kNone, kFrequencyAndDamping, kFrequency };
+std::vector<Refined> refine_with_lscf(IdentificationSummary& s, const std::vector<Recording>& recs,
+                                      const IdentificationOptions& io, const IdentificationPlan& plan) {
+  std::vector<Refined> refined_mode(s.modes.size(), Refined::kNone);
   IdentificationSummary L;
   try {
     L = identify_once(recs, "lscf", lscf_options(io), plan);
@@ -234,16 +234,17 @@ std::vector<char> refine_with_lscf(IdentificationSummary& s, const std::vector<R
     }
     if (!best) continue;
     m.frequency_hz = best->frequency_hz;
-    // LSCF's damping only where the Welch lines resolve the peak: its half-power bandwidth spans >= 4 lines (the
-    // plan's resolution rule). Below that LSCF's damping is biased high (paper frame, 300 s random force: 1.2-2.6
+    // LSCF's damping only where the Welch lines resolve the peak: its half-power bandwidth spans >= kResolvedLines
+    // (the plan's resolution rule). Below that LSCF's damping is biased high (paper frame, 300 s random force: 1.2-2.6
     // lines gave 1.21-1.43 % for 1.0 %, the frequencies within 0.1 %), and SSI's, which needs no lines, stays.
-    const bool resolved = !(L.resolution_hz > 0 && 2 * best->damping_ratio * best->frequency_hz < 4 * L.resolution_hz);
+    const bool resolved =
+        !(L.resolution_hz > 0 && 2 * best->damping_ratio * best->frequency_hz < kResolvedLines * L.resolution_hz);
     if (resolved)
       m.damping_ratio = best->damping_ratio;
     else
       ++unresolved;
     m.order_frequency_std_hz = best->order_frequency_std_hz;
-    refined_mode[k] = resolved ? 1 : 2;
+    refined_mode[k] = resolved ? Refined::kFrequencyAndDamping : Refined::kFrequency;
     ++refined;
   }
   s.notes.push_back(
@@ -253,17 +254,17 @@ std::vector<char> refine_with_lscf(IdentificationSummary& s, const std::vector<R
   if (unresolved > 0)
     s.notes.push_back(
         fmt("%.0f of the refined modes keep SSI's damping: their half-power bandwidth spans fewer "
-            "than 4 of the FRFs' %.4g Hz lines",
-            unresolved, L.resolution_hz));
+            "than %.0f of the FRFs' %.4g Hz lines",
+            unresolved, kResolvedLines, L.resolution_hz));
   return refined_mode;
 }
 
 // The refined modes' frequency and damping std: LSCF's own scatter, from the halves of the data identified by
 // LSCF (split_uncertainty), in place of the stationary response's (which describes SSI's output-only estimates:
 // with the force measured, LSCF's errors on the paper frame's random-force tests are 0.47 times that value).
-void lscf_split_uncertainty(IdentificationSummary& s, const std::vector<char>& refined, const std::vector<Recording>& A,
-                            const std::vector<Recording>& B, const IdentificationOptions& io,
-                            const IdentificationPlan& plan) {
+void lscf_split_uncertainty(IdentificationSummary& s, const std::vector<Refined>& refined,
+                            const std::vector<Recording>& A, const std::vector<Recording>& B,
+                            const IdentificationOptions& io, const IdentificationPlan& plan) {
   IdentificationSummary t;  // the modes alone: split_uncertainty reads nothing else
   t.modes = s.modes;
   try {
@@ -276,9 +277,9 @@ void lscf_split_uncertainty(IdentificationSummary& s, const std::vector<char>& r
   }
   if (!t.uncertainty_halves) return;
   for (std::size_t k = 0; k < s.modes.size(); ++k)
-    if (refined[k]) {
+    if (refined[k] != Refined::kNone) {
       s.modes[k].frequency_std_hz = t.modes[k].frequency_std_hz;
-      if (refined[k] == 1) s.modes[k].damping_std = t.modes[k].damping_std;
+      if (refined[k] == Refined::kFrequencyAndDamping) s.modes[k].damping_std = t.modes[k].damping_std;
     }
   s.notes.push_back("the LSCF-refined modes' frequency and damping std from LSCF on the same halves: " +
                     t.notes.back());
@@ -322,7 +323,7 @@ IdentificationSummary identify_recordings(std::vector<Recording> recs, const std
   io.band_hi_hz = plan.band_hi_hz;
   if (method == "ssi" && io.segment < 0 && plan.segment > 0) io.segment = plan.segment;
   IdentificationSummary s = identify_once(recs, method, io, plan);
-  std::vector<char> refined;
+  std::vector<Refined> refined;
   if (method_in.empty() && has_inputs && method == "ssi" && !s.modes.empty())
     refined = refine_with_lscf(s, recs, io, plan);
   s.band_from_data = plan.band_from_data;
@@ -342,7 +343,7 @@ IdentificationSummary identify_recordings(std::vector<Recording> recs, const std
         split_uncertainty(s, a, b);
         if (s.uncertainty_halves) s.notes.back() += " (halves: " + how + ")";
         if (!plan.impulsive) stationary_response_uncertainty(s, recs);
-        if (std::any_of(refined.begin(), refined.end(), [](char r) { return r != 0; }))
+        if (std::any_of(refined.begin(), refined.end(), [](Refined r) { return r != Refined::kNone; }))
           lscf_split_uncertainty(s, refined, A, B, h, plan);
       } catch (const InputError& e) {
         s.notes.push_back(std::string("split-data uncertainty: the halves could not be identified (") + e.what() + "); the spread over model orders is reported");

@@ -197,6 +197,10 @@ struct IdentificationSummary {
   ModalData modal_data(const std::string& source) const;
 };
 
+/// Lines of a spectrum that a mode's half-power bandwidth 2 zeta f must span for the spectrum to resolve it: the
+/// plan's resolution rule (below), and where identify_recordings takes LSCF's damping of a random-force test.
+constexpr double kResolvedLines = 4;
+
 /// The band and frequency resolution for recordings when the options leave them open: from the peaks of the
 /// summed output spectra (Welch segments of an eighth of the record), for impacts of the summed output energy
 /// spectra over the summed hit energy spectra (whole records: a sum of |FRF|^2, so that the modes above the
@@ -208,8 +212,8 @@ struct IdentificationSummary {
 ///         10 dB of its median level), when the peaks' rule stops below it (the highest modes' peaks stand out
 ///         less, or overlap).
 ///   resolution (continuous records): the lowest peak's half-power bandwidth 2 zeta f (zeta from the -3 dB
-///         width, refined with longer segments while the width spans fewer than 4 lines) spans 4 lines:
-///         segment = fs / (zeta f / 2), a power of two, at most a quarter of the shortest record (>= 7
+///         width, refined with longer segments while the width spans fewer than kResolvedLines = 4 lines) spans
+///         4 lines: segment = fs / (zeta f / 2), a power of two, at most a quarter of the shortest record (>= 7
 ///         averages with half overlap).
 struct IdentificationPlan {
   double band_lo_hz = 0, band_hi_hz = 0;
