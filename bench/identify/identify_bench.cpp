@@ -29,8 +29,8 @@
 // seeds is reported once and then counts as development data: k = 0..59 (ident1, ident2), k = 60..119 (ident3).
 // ident4 fixed k = 120..179 (seeds 200120..200179, `--split test --from 120 --count 60`) before its changes and
 // tuned on the dev seeds and on the test seeds already looked at (k < 120) only.
-// Reported since: k = 180..239 (session 35), 240..299 (session 36), 300..359 (session 44), 360..419 (session 45) and
-// 420..479 (session 47); the next fresh block is k = 480..539.
+// Reported since: k = 180..239 (session 35), 240..299 (session 36), 300..359 (session 44), 360..419 (session 45),
+// 420..479 (session 47) and 480..539 (session 48); the next fresh block is k = 540..599.
 #include <fmt/core.h>
 
 #include <algorithm>
