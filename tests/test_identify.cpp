@@ -154,6 +154,31 @@ TEST(VirtualTest, FrameImpactRoundTrip) {
   expect_identified(t.modes, identify_lscf(estimate_frf(t.recordings, fo), test::Band(0.3, 8)), 0.3, 8, kFreqTol, kDampTol, kMinMac);
 }
 
+// LSCF's automatic orders: up to kLscfOrders whatever the number of inputs (a weak mode's column becomes stable
+// only at high orders; with two references the old max(10, 60 / inputs) stopped at 30), or max(10, budget /
+// inputs) when the options give a pole budget (the random-force refinement's 60), never past the band's lines.
+TEST(VirtualTest, LscfAutomaticOrdersWithTwoReferences) {
+  const Case c = load_case(test::CasesDir() + "/paper-frame");
+  Opt o = plan(c.model, Opt::Excitation::kImpact, 25.6, 240, 10);
+  o.inputs = {{17, Dof::UX}, {20, Dof::UX}};
+  o.impacts = 3;
+  const VirtualTest t = simulate_test(c.model, all_modes(c.model), o);
+  FrfOptions fo;
+  fo.max_frequency_hz = 10;
+  const FrfData frf = estimate_frf(t.recordings, fo);
+  ASSERT_EQ(frf.num_inputs(), 2);
+  const IdentificationSummary full = identify_lscf(frf, test::Band(0.3, 8));
+  EXPECT_EQ(full.max_order, kLscfOrders);
+  expect_identified(t.modes, full, 0.3, 8, kFreqTol, kDampTol, kMinMac);
+  IdentificationOptions budget = test::Band(0.3, 8);
+  budget.lscf_pole_budget = 60;
+  EXPECT_EQ(identify_lscf(frf, budget).max_order, 30);
+  budget.lscf_pole_budget = -1;
+  std::string why;
+  EXPECT_FALSE(budget.IsValid(&why));
+  EXPECT_NE(why.find("pole budget"), std::string::npos) << why;
+}
+
 // Two hammer locations, one of which excites nothing the sensors record (a hit on a support, or on a stiff
 // anchorage): the second location's hits have the first's force records and responses at rounding level (1e-14
 // of the live ones, random). Identified with the defaults: every mode in the band as from the live location

@@ -153,6 +153,7 @@ bool IdentificationOptions::IsValid(std::string* why) const {
   if (min_order < 0 || max_order < 0 || (max_order > 0 && max_order < std::max(min_order, 2))) return fail("orders must satisfy 2 <= min <= max");
   if (max_order > 400) return fail("the maximum order is limited to 400");
   if (order_step < 0) return fail("the order step must be >= 0");
+  if (lscf_pole_budget < 0 || lscf_pole_budget > 400) return fail("the LSCF pole budget must be in [0, 400]");
   if (!(stable_frequency > 0 && stable_damping > 0 && stable_mac > 0 && stable_mac <= 1)) return fail("stability tolerances must be > 0 (MAC <= 1)");
   if (!(max_damping > 0 && max_damping < 1)) return fail("the damping limit must be in (0, 1)");
   if (!(cluster_damping > 0)) return fail("the cluster damping tolerance must be > 0");
