@@ -389,6 +389,50 @@ TEST(Selection, SecondReportOfAModeOnItsFlankIsMerged) {
   EXPECT_EQ(close.check().size(), 2u);
 }
 
+// IdentificationOptions::expected_modes: one resonance at 1 with a clear indicator peak, its cluster stable over
+// 30 % of the orders (below min_cluster_fraction 0.45, above expected_fraction 0.2). On its own it is rejected for
+// few orders; with a model mode predicted at 1.05 (within expected_ratio 1.15) of the same shape it is a mode, at
+// its own frequency, and make_modes says which model mode it was reported as. Not with a predicted shape of MAC
+// 0.01 (< expected_mac 0.9), nor at 1.2 (beyond 1.15), nor when the cluster holds 10 % of the orders (< 0.2).
+TEST(Selection, WeakClusterShapedLikeAnExpectedModeIsReported) {
+  SplitPair one(false);
+  std::vector<internal::Candidate> weak{one.cands[0]};
+  const std::vector<internal::IndicatorEvidence> ev{one.ev[0]};
+  auto with_orders = [&](int n) {
+    weak[0].cluster.members.clear();
+    for (int j = 0; j < n; ++j) weak[0].cluster.members.emplace_back(j, 0);
+    weak[0].cluster.member_weight.assign(static_cast<std::size_t>(n), 1.0);
+  };
+  with_orders(3);
+  for (int i = 0; i < 5; ++i) one.s.dofs.push_back({i + 1, Dof::UY});
+  const Eigen::VectorXd shape = weak[0].shape.real();
+  auto check = [&](std::vector<ExpectedMode> expected, IdentificationSummary* out = nullptr) {
+    IdentificationOptions o;
+    o.expected_modes = std::move(expected);
+    IdentificationSummary s = one.s;
+    const auto kept = internal::check_evidence(weak, ev, {one.power}, o, 10, s);
+    if (out) {
+      *out = s;
+      internal::make_modes(weak, ev, kept, 10, o, *out);
+    }
+    return kept.size();
+  };
+  EXPECT_EQ(check({}), 0u);
+  IdentificationSummary s;
+  EXPECT_EQ(check({{1.05, one.s.dofs, shape}}, &s), 1u);
+  ASSERT_EQ(s.modes.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.modes[0].expected_hz, 1.05);
+  EXPECT_NEAR(s.modes[0].frequency_hz, 1.0, 1e-12);  // the data's frequency, not the model's
+  EXPECT_NEAR(s.modes[0].support, 0.3, 1e-12);
+  Eigen::VectorXd other(5);
+  other << 1, 0.8, 0.3, -0.5, 1;
+  EXPECT_LT(test::Mac(other, shape), 0.02);
+  EXPECT_EQ(check({{1.05, one.s.dofs, other}}), 0u);
+  EXPECT_EQ(check({{1.2, one.s.dofs, shape}}), 0u);
+  with_orders(1);
+  EXPECT_EQ(check({{1.05, one.s.dofs, shape}}), 0u);
+}
+
 }  // namespace
 }  // namespace dynid
 

@@ -27,7 +27,11 @@ ModelBand band_from_model(const Model& model, const std::vector<MeasuredDof>& se
   for (Eigen::Index j = 0; j < mr.eigenvalues.size() && static_cast<int>(b.visible_hz.size()) < want; ++j) {
     if (mr.rigid_body[j]) continue;
     if (1.2 * mr.frequencies_hz[j] > cap) break;  // a mode at the band's edge is identified poorly
-    if (sensor_visibility(mr.modes.col(j), rows, translations) >= 0.05) b.visible_hz.push_back(mr.frequencies_hz[j]);
+    if (sensor_visibility(mr.modes.col(j), rows, translations) < 0.05) continue;
+    b.visible_hz.push_back(mr.frequencies_hz[j]);
+    ExpectedMode e{mr.frequencies_hz[j], known, Eigen::VectorXd(static_cast<Eigen::Index>(rows.size()))};
+    for (std::size_t r = 0; r < rows.size(); ++r) e.shape[static_cast<Eigen::Index>(r)] = mr.modes(rows[r], j);
+    b.expected.push_back(std::move(e));
   }
   if (b.visible_hz.empty())
     throw InputError("identification band: the sensors see no mode of the model below " + std::to_string(cap) +

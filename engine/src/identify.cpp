@@ -166,6 +166,11 @@ bool IdentificationOptions::IsValid(std::string* why) const {
   if (!(merge_tolerance >= 0 && merge_tolerance < 0.5) || !(merge_span >= 0 && merge_span < 0.5) ||
       !(merge_mac > 0 && merge_mac <= 1))
     return fail("the merge tolerance and span must be in [0, 0.5) and the merge MAC in (0, 1]");
+  if (!(expected_fraction > 0) || !(expected_mac > 0 && expected_mac <= 1) || !(expected_ratio >= 1))
+    return fail("the expected-mode fraction must be > 0, its MAC in (0, 1] and its frequency ratio >= 1");
+  for (const ExpectedMode& e : expected_modes)
+    if (!(e.frequency_hz > 0) || e.shape.size() != static_cast<Eigen::Index>(e.dofs.size()))
+      return fail("an expected mode needs a frequency > 0 and one shape entry per DOF");
   if (segment < -1 || (segment > 0 && segment < 8)) return fail("the segment must be -1 (automatic), 0 (whole records) or >= 8 samples");
   if (!(exponential_end >= 0 && exponential_end < 1)) return fail("the exponential window end must be in [0, 1)");
   return true;
@@ -249,7 +254,10 @@ ModalData IdentificationSummary::modal_data(const std::string& source) const {
     d.mpc[k] = m.mpc;
     d.frequency_std_hz[k] = m.frequency_std_hz;
     d.damping_std[k] = m.damping_std;
-    if (uncertainty_halves > 0) d.shape_std[k] = m.shape_std;
+    // A mode reported on the model's word (IdentificationOptions::expected_modes) keeps its frequency, the data's
+    // own, but its shape cannot also be evidence for or against that model: std of the largest entry (where the
+    // data carry shape std at all: not a single impact's modes).
+    if (uncertainty_halves > 0) d.shape_std[k] = m.expected_hz > 0 ? std::max(m.shape_std, 1.0) : m.shape_std;
     d.shapes.col(k) = m.real_shape;
   }
   return d;

@@ -343,6 +343,42 @@ double joint_support(const std::vector<Candidate>& cands, const std::vector<std:
 }
 }  // namespace
 
+namespace {
+// The MAC of a (complex) shape at `outputs`, taken real, with an expected mode over the DOFs both have (0 when
+// fewer than 3).
+double expected_mac_of(const Eigen::VectorXcd& shape, const std::vector<MeasuredDof>& outputs, const ExpectedMode& e) {
+  if (shape.size() != static_cast<Eigen::Index>(outputs.size())) return 0;
+  const Eigen::VectorXd x = real_normalize(shape);
+  double xy = 0, xx = 0, yy = 0;
+  int both = 0;
+  for (std::size_t i = 0; i < outputs.size(); ++i)
+    for (std::size_t j = 0; j < e.dofs.size(); ++j)
+      if (e.dofs[j].node == outputs[i].node && e.dofs[j].dof == outputs[i].dof) {
+        const double a = x[static_cast<Eigen::Index>(i)], b = e.shape[static_cast<Eigen::Index>(j)];
+        xy += a * b, xx += a * a, yy += b * b;
+        ++both;
+        break;
+      }
+  return both >= 3 && xx > 0 && yy > 0 ? xy * xy / (xx * yy) : 0.0;
+}
+
+// The expected mode (IdentificationOptions::expected_modes) a mode of this frequency and shape matches: within
+// expected_ratio in frequency and of MAC >= expected_mac, the best by MAC; -1 for none.
+int expected_match(double f, const Eigen::VectorXcd& shape, const std::vector<MeasuredDof>& outputs,
+                   const IdentificationOptions& o) {
+  int best = -1;
+  double best_mac = o.expected_mac;
+  for (std::size_t k = 0; k < o.expected_modes.size(); ++k) {
+    const ExpectedMode& e = o.expected_modes[k];
+    const double r = f / e.frequency_hz;
+    if (r > o.expected_ratio || r < 1 / o.expected_ratio) continue;
+    const double mac = expected_mac_of(shape, outputs, e);
+    if (mac >= best_mac) best = static_cast<int>(k), best_mac = mac;
+  }
+  return best;
+}
+}  // namespace
+
 std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& cands,
                                                      const std::vector<IndicatorEvidence>& ev,
                                                      const std::vector<Eigen::VectorXd>& indicators,
@@ -387,14 +423,24 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
       groups[static_cast<std::size_t>(into)].push_back(k);
     }
   }
-  // 2. Support (of the group), MPC and the mode indicator (of its strongest cluster).
+  // 2. Support (of the group), MPC and the mode indicator (of its strongest cluster). A group short of support
+  //    but shaped like a mode the model predicts (IdentificationOptions::expected_modes) is decided after the
+  //    others, so that it never stands in for a mode they report.
   std::vector<std::vector<std::size_t>> kept;
+  std::vector<const std::vector<std::size_t>*> weak;
+  std::vector<int> weak_expected;
   for (const std::vector<std::size_t>& g : groups) {
     const Candidate& h = cands[g[0]];
     const double support = joint_support(cands, g, n_orders);
     const double mpc = modal_phase_collinearity(h.shape);
     bool ok = false;
     if (support < o.min_cluster_fraction) {
+      const int e = support >= o.expected_fraction ? expected_match(h.cluster.frequency_hz, h.shape, s.dofs, o) : -1;
+      if (e >= 0) {
+        weak.push_back(&g);
+        weak_expected.push_back(e);
+        continue;
+      }
       for (std::size_t k : g) reject(cands[k].cluster, Rejection::kFewOrders, support, o.min_cluster_fraction);
     } else if (mpc < o.min_mpc) {
       for (std::size_t k : g) reject(cands[k].cluster, Rejection::kComplexShape, mpc, o.min_mpc);
@@ -406,6 +452,21 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
       ok = true;
     }
     if (ok) kept.push_back(g);
+  }
+  for (std::size_t w = 0; w < weak.size(); ++w) {
+    const std::vector<std::size_t>& g = *weak[w];
+    const Candidate& h = cands[g[0]];
+    const double support = joint_support(cands, g, n_orders);
+    bool taken = false;  // a reported mode already is that model mode
+    for (const std::vector<std::size_t>& k : kept)
+      taken =
+          taken || expected_match(cands[k[0]].cluster.frequency_hz, cands[k[0]].shape, s.dofs, o) == weak_expected[w];
+    const double mpc = modal_phase_collinearity(h.shape);
+    if (taken || mpc < o.min_mpc || ev[g[0]].peak_db < o.min_peak_db || ev[g[0]].edge_db > o.max_edge_db) {
+      for (std::size_t k : g) reject(cands[k].cluster, Rejection::kFewOrders, support, o.min_cluster_fraction);
+      continue;
+    }
+    kept.push_back(g);
   }
   // Ascending frequency (of the strongest cluster); the splits are listed against the mode they joined.
   std::sort(kept.begin(), kept.end(), [&](const auto& a, const auto& b) { return cands[a[0]].cluster.frequency_hz < cands[b[0]].cluster.frequency_hz; });
@@ -419,8 +480,9 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
   return kept;
 }
 
-void make_modes(const std::vector<Candidate>& cands, const std::vector<IndicatorEvidence>& ev, const std::vector<std::vector<std::size_t>>& accepted,
-                std::size_t n_orders, IdentificationSummary& s) {
+void make_modes(const std::vector<Candidate>& cands, const std::vector<IndicatorEvidence>& ev,
+                const std::vector<std::vector<std::size_t>>& accepted, std::size_t n_orders,
+                const IdentificationOptions& o, IdentificationSummary& s) {
   s.modes.clear();
   for (const std::vector<std::size_t>& g : accepted) {
     const Candidate& c = cands[g[0]];
@@ -435,6 +497,10 @@ void make_modes(const std::vector<Candidate>& cands, const std::vector<Indicator
     m.mpc = modal_phase_collinearity(c.shape);
     m.real_shape = real_normalize(c.shape);
     m.support = joint_support(cands, g, n_orders);
+    if (m.support < o.min_cluster_fraction) {
+      const int e = expected_match(m.frequency_hz, c.shape, s.dofs, o);
+      if (e >= 0) m.expected_hz = o.expected_modes[static_cast<std::size_t>(e)].frequency_hz;
+    }
     for (std::size_t k : g) {
       m.poles += cands[k].cluster.poles;
       for (int d : cands[k].cluster.diagram_index) s.poles[static_cast<std::size_t>(d)].cluster = static_cast<int>(s.modes.size());
@@ -464,7 +530,7 @@ void select_modes(const OrderPoles& op, double lo, double hi, const Identificati
     const double zw = clusters[c].damping_ratio + decay / (2 * M_PI * clusters[c].frequency_hz);
     peak[c] = indicator_evidence(s.frequency_hz, own[c], clusters[c].frequency_hz, zw);
   }
-  make_modes(cands, peak, check_evidence(cands, peak, own, o, op.poles.size(), s), op.poles.size(), s);
+  make_modes(cands, peak, check_evidence(cands, peak, own, o, op.poles.size(), s), op.poles.size(), o, s);
 }
 
 }  // namespace dynid::internal

@@ -232,6 +232,7 @@ void identify_recordings_for(const Case& c, std::vector<Recording> recs, Discove
     const ModelBand b = band_from_model(c.model, sensors, recs[0].sample_rate_hz / 2);
     io.band_lo_hz = b.lo_hz;
     io.band_hi_hz = b.hi_hz;
+    io.expected_modes = b.expected;
     out->notes.push_back("identification band " + format_number(b.lo_hz, 4) + " to " + format_number(b.hi_hz, 4) + " Hz, from the " +
                          std::to_string(b.visible_hz.size()) + " lowest modes of the model the sensors see (" +
                          format_number(b.visible_hz.front(), 4) + " to " + format_number(b.visible_hz.back(), 4) + " Hz)");
@@ -240,6 +241,13 @@ void identify_recordings_for(const Case& c, std::vector<Recording> recs, Discove
   }
   out->identification = identify_recordings(std::move(recs), method, io);
   out->identified = true;
+  for (const IdentifiedMode& m : out->identification.modes)
+    if (m.expected_hz > 0)
+      out->notes.push_back("identified mode at " + format_number(m.frequency_hz, 5) + " Hz: stable over " +
+                           format_number(m.support, 2) + " of the orders (< " +
+                           format_number(io.min_cluster_fraction, 2) +
+                           "), reported because its shape matches the model's mode at " +
+                           format_number(m.expected_hz, 5) + " Hz (MAC >= " + format_number(io.expected_mac, 2) + ")");
   out->measured = out->identification.modal_data("identified from " + out->source);
   const Eigen::Index found = out->measured.num_modes();
   if (found < 2)

@@ -98,9 +98,11 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
                                                      IdentificationSummary& s);
 
 /// The accepted modes as IdentifiedModes (frequency, damping, spreads and shape of the strongest cluster, the
-/// joint support of all), and the diagram's poles marked with their mode.
-void make_modes(const std::vector<Candidate>& candidates, const std::vector<IndicatorEvidence>& evidence, const std::vector<std::vector<std::size_t>>& accepted,
-                std::size_t n_orders, IdentificationSummary& s);
+/// joint support of all; a mode short of support: the expected mode it was reported as), and the diagram's poles
+/// marked with their mode.
+void make_modes(const std::vector<Candidate>& candidates, const std::vector<IndicatorEvidence>& evidence,
+                const std::vector<std::vector<std::size_t>>& accepted, std::size_t n_orders,
+                const IdentificationOptions& options, IdentificationSummary& s);
 
 /// A cluster's shape (complex, at the outputs), given every cluster (LSCF fits it with its neighbours' poles),
 /// and its strength when the method measures one (< 0: its support): of two clusters of one mode (a split), the

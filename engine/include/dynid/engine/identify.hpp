@@ -86,6 +86,14 @@ namespace dynid {
 /// LSCF's highest model order when the options leave the orders open, whatever the number of inputs.
 constexpr int kLscfOrders = 60;
 
+/// A mode a model predicts for the test: its frequency and its shape at measured DOFs (IdentificationOptions::
+/// expected_modes).
+struct ExpectedMode {
+  double frequency_hz = 0;
+  std::vector<MeasuredDof> dofs;
+  Eigen::VectorXd shape;  ///< at `dofs`
+};
+
 struct IdentificationOptions {
   /// Analysis band. 0, 0 = identify_lscf / identify_ssi: everything the data holds above 0 Hz;
   /// identify_recordings: from the data's spectral peaks (plan_identification).
@@ -109,6 +117,15 @@ struct IdentificationOptions {
   double merge_tolerance = 0.03;    ///< clusters this close (relative, or zeta if wider) ...
   double merge_mac = 0.9;           ///< ... with shapes this alike are one mode
   double merge_span = 0.15;         ///< so are those this close on the flank of the stronger's peak
+  /// The modes a model predicts (empty = none; discover fills them from the analysis model when it takes the band
+  /// from it: band_from_model). A cluster stable over fewer than min_cluster_fraction of the orders, but over at
+  /// least expected_fraction, is still a mode (with every other piece of evidence: MPC, the mode indicator) when
+  /// its shape matches one of these, at expected_mac or better over at least 3 of its outputs, within
+  /// expected_ratio in frequency, and no mode already reported matches that one: a weak mode the model says is
+  /// there, shaped as the model says, is not noise. Its frequency and damping stay the data's own; it carries
+  /// IdentifiedMode::expected_hz, and its shape no weight in IdentificationSummary::modal_data (docs/method.md).
+  std::vector<ExpectedMode> expected_modes;
+  double expected_fraction = 0.2, expected_mac = 0.9, expected_ratio = 1.15;
   // SSI-cov.
   int block_rows = 0;  ///< i (0 = automatic from the band's lowest frequency and the maximum order)
   int decimate = 0;    ///< 0 = automatic (to about 2.5x the band's top), 1 = none
@@ -143,6 +160,9 @@ struct IdentifiedMode {
   double shape_std = 0;  ///< std of the shape entries relative to the largest (split data; 0 = not estimated)
   int poles = 0;                                 ///< poles in its cluster (orders that found it)
   double support = 0;                            ///< weighted share of the orders (header comment, step 2)
+  /// The model's mode (IdentificationOptions::expected_modes) this one was reported as, its support short of
+  /// min_cluster_fraction; 0 = reported on its own evidence.
+  double expected_hz = 0;
   double indicator_db = 0;  ///< mode indicator above (+) or below (-) the line between its surroundings, dB
   Eigen::VectorXcd shape;                        ///< complex shape at the outputs (LSFD residues / SSI C psi)
   Eigen::VectorXd real_shape;                    ///< real-normalized (best real rotation), max |.| = 1
@@ -270,6 +290,7 @@ FrfData merge_frfs(std::vector<FrfData> sets);
 struct ModelBand {
   double lo_hz = 0, hi_hz = 0;
   std::vector<double> visible_hz;  ///< the visible model modes the band covers
+  std::vector<ExpectedMode> expected;  ///< the same modes, with their shapes at the sensors on the model's free DOFs
 };
 ModelBand band_from_model(const Model& model, const std::vector<MeasuredDof>& sensors, double nyquist_hz, int modes = 8);
 
