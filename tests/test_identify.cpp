@@ -154,9 +154,8 @@ TEST(VirtualTest, FrameImpactRoundTrip) {
   expect_identified(t.modes, identify_lscf(estimate_frf(t.recordings, fo), test::Band(0.3, 8)), 0.3, 8, kFreqTol, kDampTol, kMinMac);
 }
 
-// LSCF's automatic orders: up to kLscfOrders whatever the number of inputs (a weak mode's column becomes stable
-// only at high orders; with two references the old max(10, 60 / inputs) stopped at 30), or max(10, budget /
-// inputs) when the options give a pole budget (the random-force refinement's 60), never past the band's lines.
+// LSCF's automatic orders: up to max(10, kLscfOrders / inputs), 30 with two references (every mode of the band
+// found), or max(10, budget / inputs) when the options give a pole budget (120: 60), never past the band's lines.
 TEST(VirtualTest, LscfAutomaticOrdersWithTwoReferences) {
   const Case c = load_case(test::CasesDir() + "/paper-frame");
   Opt o = plan(c.model, Opt::Excitation::kImpact, 25.6, 240, 10);
@@ -168,11 +167,11 @@ TEST(VirtualTest, LscfAutomaticOrdersWithTwoReferences) {
   const FrfData frf = estimate_frf(t.recordings, fo);
   ASSERT_EQ(frf.num_inputs(), 2);
   const IdentificationSummary full = identify_lscf(frf, test::Band(0.3, 8));
-  EXPECT_EQ(full.max_order, kLscfOrders);
+  EXPECT_EQ(full.max_order, kLscfOrders / 2);
   expect_identified(t.modes, full, 0.3, 8, kFreqTol, kDampTol, kMinMac);
   IdentificationOptions budget = test::Band(0.3, 8);
-  budget.lscf_pole_budget = 60;
-  EXPECT_EQ(identify_lscf(frf, budget).max_order, 30);
+  budget.lscf_pole_budget = 120;
+  EXPECT_EQ(identify_lscf(frf, budget).max_order, 60);
   budget.lscf_pole_budget = -1;
   std::string why;
   EXPECT_FALSE(budget.IsValid(&why));

@@ -292,14 +292,14 @@ LscfInput lscf_input(const FrfData& frf_in, const IdentificationOptions& o) {
     if (frf.frequency_hz[k] > 0 && frf.frequency_hz[k] >= in.lo && frf.frequency_hz[k] <= in.hi) lines.push_back(k);
   const Eigen::Index nf = static_cast<Eigen::Index>(lines.size());
   in.ni = frf.num_inputs(), in.no = frf.num_outputs();
-  // Orders not given: up to kLscfOrders whatever the number of inputs (or max(10, lscf_pole_budget / inputs) when
-  // given), but no more than the band's lines support (a narrow band of a short record); orders given are kept or
-  // refused. The poles per order grow with the inputs, but a weak mode's column becomes stable only at high orders:
-  // with two hammer locations, orders to 60 / inputs = 30 left modes 40 dB below the strongest without a stable
-  // column (identification benchmark, dev impacts: 137 -> 140 of 157 modes found, spurious 2 -> 1).
-  in.pmax = o.max_order > 0          ? o.max_order
-            : o.lscf_pole_budget > 0 ? std::max(10, o.lscf_pole_budget / in.ni)
-                                     : kLscfOrders;
+  // Orders not given: up to max(10, budget / inputs), the budget kLscfOrders unless lscf_pole_budget gives one
+  // (the poles per order grow with the inputs), but no more than the band's lines support (a narrow band of a short
+  // record); orders given are kept or refused. Orders to 60 whatever the inputs (1cb0c07, reverted) found more
+  // modes of two-hammer tests (identification benchmark, dev impacts: 137 -> 140 of 157) but cost discovery: the
+  // bundled frame-null called missing physics in 3 of 40 seeds (a 96 Hz mode 0.6 % off), frame-damage missed 1,
+  // and on the discovery benchmark's test recordings it gained 1 case and lost 2 (bench/discovery/README.md).
+  in.pmax =
+      o.max_order > 0 ? o.max_order : std::max(10, (o.lscf_pole_budget > 0 ? o.lscf_pole_budget : kLscfOrders) / in.ni);
   in.pmin = o.min_order > 0 ? o.min_order : 2;
   if (o.max_order == 0) in.pmax = std::min(in.pmax, static_cast<int>(nf / 2) - 1);
   in.step = o.order_step > 0 ? o.order_step : 1;

@@ -196,9 +196,9 @@ IdentificationSummary identify_once(const std::vector<Recording>& recs, const st
   return identify_ssi(all, io);
 }
 
-// Options for LSCF beside an SSI run: automatic orders (SSI's are no LSCF orders), up to 60 poles: on Welch FRFs
-// with a few lines per half-power bandwidth, orders to kLscfOrders with two shakers biased two dev modes of the
-// identification benchmark's random-force tests beyond 0.5 % (bench/README.md).
+// Options for LSCF beside an SSI run: automatic orders (SSI's are no LSCF orders), up to 60 poles whatever the
+// options' budget: on Welch FRFs with a few lines per half-power bandwidth, orders to 60 with two shakers biased
+// two dev modes of the identification benchmark's random-force tests beyond 0.5 % (bench/README.md).
 IdentificationOptions lscf_options(IdentificationOptions io) {
   io.min_order = io.max_order = io.order_step = 0;
   io.lscf_pole_budget = 60;

@@ -83,7 +83,7 @@
 
 namespace dynid {
 
-/// LSCF's highest model order when the options leave the orders open, whatever the number of inputs.
+/// LSCF's pole budget when the options leave the orders open: orders up to max(10, kLscfOrders / inputs).
 constexpr int kLscfOrders = 60;
 
 /// A mode a model predicts for the test: its frequency and its shape at measured DOFs (IdentificationOptions::
@@ -98,9 +98,9 @@ struct IdentificationOptions {
   /// Analysis band. 0, 0 = identify_lscf / identify_ssi: everything the data holds above 0 Hz;
   /// identify_recordings: from the data's spectral peaks (plan_identification).
   double band_lo_hz = 0, band_hi_hz = 0;
-  int min_order = 0, max_order = 0;       ///< model orders (0 = automatic: LSCF 2..kLscfOrders; SSI 2..80)
+  int min_order = 0, max_order = 0;       ///< model orders (0 = automatic: LSCF 2..max(10, 60 / inputs); SSI 2..80)
   int order_step = 0;                     ///< 0 = 1 (LSCF), 2 (SSI)
-  int lscf_pole_budget = 0;               ///< > 0: automatic LSCF orders up to max(10, this / inputs) instead
+  int lscf_pole_budget = 0;               ///< > 0: automatic LSCF orders up to max(10, this / inputs) (0: kLscfOrders)
   // Stability against the previous order (full weight within these, none beyond twice them).
   double stable_frequency = 0.01;   ///< relative frequency change
   double stable_damping = 0.05;     ///< relative damping change (the diagram's "stable in damping" mark)
