@@ -7,6 +7,8 @@
 #include <cmath>
 #include <map>
 
+#include "dynid/engine/correlation.hpp"
+
 namespace dynid::internal {
 
 namespace {
@@ -344,39 +346,48 @@ double joint_support(const std::vector<Candidate>& cands, const std::vector<std:
 }  // namespace
 
 namespace {
-// The MAC of a (complex) shape at `outputs`, taken real, with an expected mode over the DOFs both have (0 when
-// fewer than 3).
-double expected_mac_of(const Eigen::VectorXcd& shape, const std::vector<MeasuredDof>& outputs, const ExpectedMode& e) {
-  if (shape.size() != static_cast<Eigen::Index>(outputs.size())) return 0;
-  const Eigen::VectorXd x = real_normalize(shape);
-  double xy = 0, xx = 0, yy = 0;
-  int both = 0;
-  for (std::size_t i = 0; i < outputs.size(); ++i)
-    for (std::size_t j = 0; j < e.dofs.size(); ++j)
-      if (e.dofs[j].node == outputs[i].node && e.dofs[j].dof == outputs[i].dof) {
-        const double a = x[static_cast<Eigen::Index>(i)], b = e.shape[static_cast<Eigen::Index>(j)];
-        xy += a * b, xx += a * a, yy += b * b;
-        ++both;
-        break;
-      }
-  return both >= 3 && xx > 0 && yy > 0 ? xy * xy / (xx * yy) : 0.0;
-}
-
-// The expected mode (IdentificationOptions::expected_modes) a mode of this frequency and shape matches: within
-// expected_ratio in frequency and of MAC >= expected_mac, the best by MAC; -1 for none.
-int expected_match(double f, const Eigen::VectorXcd& shape, const std::vector<MeasuredDof>& outputs,
-                   const IdentificationOptions& o) {
-  int best = -1;
-  double best_mac = o.expected_mac;
-  for (std::size_t k = 0; k < o.expected_modes.size(); ++k) {
-    const ExpectedMode& e = o.expected_modes[k];
-    const double r = f / e.frequency_hz;
-    if (r > o.expected_ratio || r < 1 / o.expected_ratio) continue;
-    const double mac = expected_mac_of(shape, outputs, e);
-    if (mac >= best_mac) best = static_cast<int>(k), best_mac = mac;
+// The expected modes (IdentificationOptions::expected_modes) aligned to the outputs once: column k holds mode k's
+// shape on the outputs it shares, `shared` marks them (1), 0 elsewhere.
+class ExpectedAtOutputs {
+ public:
+  ExpectedAtOutputs(const IdentificationOptions& o, const std::vector<MeasuredDof>& outputs)
+      : o_(o),
+        shapes_(Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(outputs.size()),
+                                      static_cast<Eigen::Index>(o.expected_modes.size()))),
+        shared_(Eigen::MatrixXd::Zero(shapes_.rows(), shapes_.cols())) {
+    for (Eigen::Index k = 0; k < shapes_.cols(); ++k) {
+      const ExpectedMode& e = o.expected_modes[static_cast<std::size_t>(k)];
+      for (Eigen::Index i = 0; i < shapes_.rows(); ++i)
+        for (std::size_t j = 0; j < e.dofs.size(); ++j)
+          if (e.dofs[j].node == outputs[static_cast<std::size_t>(i)].node &&
+              e.dofs[j].dof == outputs[static_cast<std::size_t>(i)].dof) {
+            shapes_(i, k) = e.shape[static_cast<Eigen::Index>(j)];
+            shared_(i, k) = 1;
+            break;
+          }
+    }
   }
-  return best;
-}
+  // The expected mode a mode of this frequency and (complex, at the outputs) shape matches: within expected_ratio in
+  // frequency and of MAC >= expected_mac over at least 3 shared outputs (its shape taken real), the best by MAC;
+  // -1 for none.
+  int match(double f, const Eigen::VectorXcd& shape) const {
+    if (shape.size() != shapes_.rows()) return -1;
+    const Eigen::VectorXd x = real_normalize(shape);
+    int best = -1;
+    double best_mac = o_.expected_mac;
+    for (Eigen::Index k = 0; k < shapes_.cols(); ++k) {
+      const double r = f / o_.expected_modes[static_cast<std::size_t>(k)].frequency_hz;
+      if (r > o_.expected_ratio || r < 1 / o_.expected_ratio || shared_.col(k).sum() < 3) continue;
+      const double mac = mac_matrix(x.cwiseProduct(shared_.col(k)), shapes_.col(k))(0, 0);
+      if (mac >= best_mac) best = static_cast<int>(k), best_mac = mac;
+    }
+    return best;
+  }
+
+ private:
+  const IdentificationOptions& o_;
+  Eigen::MatrixXd shapes_, shared_;
+};
 }  // namespace
 
 std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& cands,
@@ -427,6 +438,7 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
   //    but shaped like a mode the model predicts (IdentificationOptions::expected_modes) is decided after the
   //    others, so that it never stands in for a mode they report.
   std::vector<std::vector<std::size_t>> kept;
+  const ExpectedAtOutputs expected(o, s.dofs);
   std::vector<const std::vector<std::size_t>*> weak;
   std::vector<int> weak_expected;
   for (const std::vector<std::size_t>& g : groups) {
@@ -435,7 +447,7 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
     const double mpc = modal_phase_collinearity(h.shape);
     bool ok = false;
     if (support < o.min_cluster_fraction) {
-      const int e = support >= o.expected_fraction ? expected_match(h.cluster.frequency_hz, h.shape, s.dofs, o) : -1;
+      const int e = support >= o.expected_fraction ? expected.match(h.cluster.frequency_hz, h.shape) : -1;
       if (e >= 0) {
         weak.push_back(&g);
         weak_expected.push_back(e);
@@ -459,8 +471,7 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
     const double support = joint_support(cands, g, n_orders);
     bool taken = false;  // a reported mode already is that model mode
     for (const std::vector<std::size_t>& k : kept)
-      taken =
-          taken || expected_match(cands[k[0]].cluster.frequency_hz, cands[k[0]].shape, s.dofs, o) == weak_expected[w];
+      taken = taken || expected.match(cands[k[0]].cluster.frequency_hz, cands[k[0]].shape) == weak_expected[w];
     const double mpc = modal_phase_collinearity(h.shape);
     if (taken || mpc < o.min_mpc || ev[g[0]].peak_db < o.min_peak_db || ev[g[0]].edge_db > o.max_edge_db) {
       for (std::size_t k : g) reject(cands[k].cluster, Rejection::kFewOrders, support, o.min_cluster_fraction);
@@ -484,6 +495,7 @@ void make_modes(const std::vector<Candidate>& cands, const std::vector<Indicator
                 const std::vector<std::vector<std::size_t>>& accepted, std::size_t n_orders,
                 const IdentificationOptions& o, IdentificationSummary& s) {
   s.modes.clear();
+  const ExpectedAtOutputs expected(o, s.dofs);
   for (const std::vector<std::size_t>& g : accepted) {
     const Candidate& c = cands[g[0]];
     IdentifiedMode m;
@@ -498,7 +510,7 @@ void make_modes(const std::vector<Candidate>& cands, const std::vector<Indicator
     m.real_shape = real_normalize(c.shape);
     m.support = joint_support(cands, g, n_orders);
     if (m.support < o.min_cluster_fraction) {
-      const int e = expected_match(m.frequency_hz, c.shape, s.dofs, o);
+      const int e = expected.match(m.frequency_hz, c.shape);
       if (e >= 0) m.expected_hz = o.expected_modes[static_cast<std::size_t>(e)].frequency_hz;
     }
     for (std::size_t k : g) {
