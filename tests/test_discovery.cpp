@@ -249,6 +249,36 @@ TEST(DiscoveryStages, AnEffectFittedToNothingIsNoFinding) {
 }
 
 // Nothing missing: the data are the analysis model's own modes.
+// The findings' probability among the explanations (internal::story_odds), against hand-computed odds: with
+// findings at ln evidence 10, an equivalent site at 10 counts for them, a same-kind site elsewhere at 9 only for
+// their kinds, another physics at three sites (10, 10.2, 10) and the recalibration at 8 against. Exact arithmetic
+// (1e-12).
+TEST(DiscoveryStages, StoryOddsSumAPhysicsOverItsSites) {
+  using R = internal::StoryOdds::Relation;
+  const std::vector<std::string> spring = {"spring"}, preload = {"preload"};
+  std::vector<internal::StoryOdds::Entry> e = {{R::kSameStory, 10, preload}, {R::kSameKinds, 9, preload},
+                                               {R::kOther, 10, spring},      {R::kOther, 10.2, spring},
+                                               {R::kOther, 10, spring},      {R::kOther, 8, {}}};
+  const double same = 1, kind = std::exp(-1.0), sp = 2 + std::exp(0.2), rec = std::exp(-2.0);
+  const double total = 1 + same + kind + sp + rec + std::exp(-10.0);
+  internal::StoryOdds o = internal::story_odds(10, e);
+  EXPECT_NEAR(o.probability, (1 + same) / total, 1e-12);
+  EXPECT_NEAR(o.kind_probability, (1 + same + kind) / total, 1e-12);
+  EXPECT_EQ(o.other, 3);  // the spring's best site
+  EXPECT_NEAR(o.other_probability, sp / total, 1e-12);
+  EXPECT_LT(o.kind_probability, 0.5);   // the findings' physics is not the most probable story ...
+  EXPECT_GT(o.other_probability, 0.5);  // ... the spring, over its three sites, is: discover() names it
+  // A same-kind site more probable than the findings' own: their kinds' probability is their site's.
+  e[1].log_evidence = 10.5;
+  o = internal::story_odds(10, e);
+  EXPECT_NEAR(o.kind_probability, o.probability, 1e-15);
+  // The recalibration is no physics: never the other story, however probable.
+  e = {{R::kOther, 12, {}}, {R::kOther, 9, spring}};
+  o = internal::story_odds(10, e);
+  EXPECT_EQ(o.other, 1);
+  EXPECT_NEAR(o.other_probability, std::exp(-1.0) / (1 + std::exp(2.0) + std::exp(-1.0) + std::exp(-10.0)), 1e-12);
+}
+
 TEST(Discovery, ExactDataOfTheModelIsConsistent) {
   const Model analysis = make_frame2d(portal());
   const ModalData meas = exact_modes(analysis, analysis, 6);

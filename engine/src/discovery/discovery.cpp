@@ -73,6 +73,38 @@ std::vector<std::unique_ptr<Candidate>> candidate_library(const Model& model, co
   return std::move(p.library);
 }
 
+namespace internal {
+
+StoryOdds story_odds(double best, const std::vector<StoryOdds::Entry>& entries) {
+  double same_story = 0, same_kinds = 0, most_same_kinds = 0, against = std::exp(-best);
+  std::map<std::vector<std::string>, std::pair<double, int>> by_kinds;  // odds summed, best entry
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    const StoryOdds::Entry& e = entries[k];
+    const double odds = std::exp(e.log_evidence - best);
+    if (e.relation == StoryOdds::Relation::kSameStory) {
+      same_story += odds;
+    } else if (e.relation == StoryOdds::Relation::kSameKinds) {
+      same_kinds += odds;
+      most_same_kinds = std::max(most_same_kinds, odds);
+    } else {
+      against += odds;
+      if (e.kinds.empty()) continue;
+      auto& [sum, at] = by_kinds.try_emplace(e.kinds, 0.0, static_cast<int>(k)).first->second;
+      sum += odds;
+      if (e.log_evidence > entries[static_cast<std::size_t>(at)].log_evidence) at = static_cast<int>(k);
+    }
+  }
+  StoryOdds o;
+  const double total = 1.0 + same_story + same_kinds + against;
+  o.probability = (1.0 + same_story) / total;
+  o.kind_probability = most_same_kinds > 1 ? o.probability : (1.0 + same_story + same_kinds) / total;
+  for (const auto& [kinds, v] : by_kinds)
+    if (v.first / total > o.other_probability) o.other_probability = v.first / total, o.other = v.second;
+  return o;
+}
+
+}  // namespace internal
+
 namespace {
 
 using namespace internal;
@@ -213,8 +245,14 @@ Equivalents name_equivalent_sites(const Problem& p, const Selection& sel, const 
 // Rivals: complete explanations of other stories (the other chains' results and the single candidates), and the
 // recalibration, within `ambiguity` in evidence; the findings' probability against every one of them scored
 // (and the model as given, at 0).
-void weigh_rivals(const Problem& p, const Selection& sel, const std::vector<SetFit>& singles, const SetFit& recal,
-                  const Equivalents& equivalent, DiscoverySummary* S) {
+// Returns the most probable other physics: its best explanation and the probability of its kinds, summed over
+// their sites and explanations.
+struct OtherPhysics {
+  const SetFit* fit = nullptr;
+  double probability = 0;
+};
+OtherPhysics weigh_rivals(const Problem& p, const Selection& sel, const std::vector<SetFit>& singles,
+                          const SetFit& recal, const Equivalents& equivalent, DiscoverySummary* S) {
   // Whether a set of effects tells another story than the findings: an effect unlike every finding.
   auto like = [&](const Candidate* x, const Candidate* f) {
     if (x == f || same_story(*p.model, *x, *f)) return true;
@@ -238,25 +276,28 @@ void weigh_rivals(const Problem& p, const Selection& sel, const std::vector<SetF
   };
   const std::vector<std::string> found_kinds = kinds_of(sel.fit.set);
   const double best = S->combined.log_evidence;
-  double odds_against = std::exp(-best), odds_same_kinds = 0, most_same_kinds = 0;
-  std::vector<const SetFit*> others;
+  std::vector<const SetFit*> others, pool;
   for (const SetFit& a : sel.alternatives) others.push_back(&a);
   for (const SetFit& f : singles)
     if (f.ok && !f.at_bound) others.push_back(&f);
-  std::set<std::vector<const Candidate*>> seen;  // a set reached twice (two starts, a chain of one) counts once
-  for (const SetFit* a : others) {
-    if (a->set.size() > sel.fit.set.size() || !other_story(a->set)) continue;
-    std::vector<const Candidate*> key(a->set.begin(), a->set.end());
+  // A set reached twice (two starts, a chain of one) counts once; the findings' own set not at all.
+  auto key_of = [](const std::vector<const Candidate*>& a) {
+    std::vector<const Candidate*> key(a.begin(), a.end());
     std::sort(key.begin(), key.end());
-    if (!seen.insert(key).second) continue;
-    const double le = log_evidence(p, *a), odds = std::exp(le - best);
-    if (kinds_of(a->set) == found_kinds) {
-      odds_same_kinds += odds;
-      most_same_kinds = std::max(most_same_kinds, odds);
-    } else {
-      odds_against += odds;
-    }
-    if (le < best - p.options.ambiguity) continue;
+    return key;
+  };
+  std::set<std::vector<const Candidate*>> seen = {key_of(sel.fit.set)};
+  std::vector<StoryOdds::Entry> entries;
+  for (const SetFit* a : others) {
+    if (a->set.size() > sel.fit.set.size() || !seen.insert(key_of(a->set)).second) continue;
+    const double le = log_evidence(p, *a);
+    const std::vector<std::string> kinds = kinds_of(a->set);
+    const StoryOdds::Relation rel = !other_story(a->set)   ? StoryOdds::Relation::kSameStory
+                                    : kinds == found_kinds ? StoryOdds::Relation::kSameKinds
+                                                           : StoryOdds::Relation::kOther;
+    entries.push_back({rel, le, kinds});
+    pool.push_back(a);
+    if (rel == StoryOdds::Relation::kSameStory || le < best - p.options.ambiguity) continue;
     ScoredHypothesis h = score_fit(p, *a, 0, sel.chi2_best);
     std::vector<std::size_t> all(a->set.size());
     std::iota(all.begin(), all.end(), 0);
@@ -264,16 +305,18 @@ void weigh_rivals(const Problem& p, const Selection& sel, const std::vector<SetF
     S->rivals.push_back(std::move(h));
   }
   if (recal.ok && !recal.at_bound) {
-    odds_against += std::exp(S->recalibration.log_evidence - best);
+    entries.push_back({StoryOdds::Relation::kOther, S->recalibration.log_evidence, {}});
     if (S->recalibration.log_evidence >= best - p.options.ambiguity) S->rivals.push_back(S->recalibration);
   }
   std::stable_sort(S->rivals.begin(), S->rivals.end(), [](const ScoredHypothesis& a, const ScoredHypothesis& b) {
     return a.log_evidence > b.log_evidence;
   });
-  S->probability = 1.0 / (1.0 + odds_same_kinds + odds_against);
-  // The findings' kinds, wherever they sit; only while the findings are their kinds' most probable sites.
-  S->kind_probability =
-      most_same_kinds > 1 ? S->probability : (1.0 + odds_same_kinds) / (1.0 + odds_same_kinds + odds_against);
+  const StoryOdds o = story_odds(best, entries);
+  S->probability = o.probability;
+  S->kind_probability = o.kind_probability;
+  OtherPhysics other;
+  if (o.other >= 0) other = {pool[static_cast<std::size_t>(o.other)], o.other_probability};
+  return other;
 }
 
 // The verdict on an explanation: missing physics when its kinds are the most probable story (the findings' sites
@@ -381,13 +424,44 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
     S.reason = VerdictReason::kNothingDecisive;
     return finish();
   }
-  const std::vector<std::size_t> order = report_findings(p, sel, &S);
-  S.steps = sel.steps;
-  S.after = sel.fit.quality;
-  check_set_aside(p, measured, sel.fit, &S.set_aside);
-  const Equivalents equivalent = name_equivalent_sites(p, sel, singles, order, &S);
-  weigh_rivals(p, sel, singles, recal, equivalent, &S);
-  decide(p, sel, &S);
+  const DiscoverySummary unexplained = S;
+  auto explain = [&](const Selection& e, DiscoverySummary* T) {
+    const std::vector<std::size_t> order = report_findings(p, e, T);
+    T->steps = e.steps;
+    T->after = e.fit.quality;
+    check_set_aside(p, measured, e.fit, &T->set_aside);
+    const Equivalents equivalent = name_equivalent_sites(p, e, singles, order, T);
+    const OtherPhysics other = weigh_rivals(p, e, singles, recal, equivalent, T);
+    decide(p, e, T);
+    return other;
+  };
+  const OtherPhysics other = explain(sel, &S);
+  // The physics is what is asked: its probability is the sum over its sites and explanations. When the best
+  // explanation's kinds are not the most probable story (rivals) and another physics is, on the same pool of
+  // explanations, that physics' best single-effect explanation is named instead (where stays uncertain: the
+  // verdict then says so), provided it may stand as an explanation itself.
+  if (S.verdict == Verdict::kInconclusive && S.reason == VerdictReason::kRivals && other.fit &&
+      other.probability >= options.min_probability && other.fit->set.size() == 1 &&
+      admissible(p, *other.fit, S.before) && log_evidence(p, *other.fit) >= options.decisive) {
+    Selection e;
+    e.fit = *other.fit;
+    e.importance = {log_evidence(p, e.fit)};
+    SelectionStep st;
+    st.action = SelectionStep::Action::kStart;
+    st.description = e.fit.set[0]->description();
+    st.log_evidence = e.importance[0];
+    st.explained = explained_share(p, e.fit, sel.chi2_best);
+    st.max_freq_error_pct = e.fit.quality.max_freq_error_pct;
+    st.mean_mac = e.fit.quality.mean_mac;
+    e.steps = {st};
+    e.alternatives.push_back(sel.fit);
+    for (const SetFit& a : sel.alternatives)
+      if (a.set != e.fit.set) e.alternatives.push_back(a);
+    e.chi2_best = sel.chi2_best;
+    DiscoverySummary T = unexplained;
+    explain(e, &T);
+    if (T.verdict == Verdict::kMissingPhysics) S = std::move(T);
+  }
   return finish();
 }
 

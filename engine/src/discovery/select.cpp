@@ -28,6 +28,32 @@ namespace {
 // cases/discovery/frame-two-effects (25 of 40 seeds instead of 40): the frequency stays strict.
 double mac_tolerance(const Problem& p) { return std::clamp(0.5 * p.noise.shape * p.noise.shape, 1e-4, 1e-3); }
 
+}  // namespace
+
+// A set that may stand as an explanation: fitted, inside its bounds, no worse than the model as given in its
+// largest frequency error or its mean MAC (to mac_tolerance), every effect significant, at most one
+// parameter per two measured modes. Significant: the magnitude's Wald z; a lone effect whose posterior is too
+// far from normal for a Wald test (a support spring towards pinned, where the frequencies stop seeing the
+// flexibility) is significant when it is decisive against the model as given by its evidence and by the
+// likelihood ratio at the data's noise (chi2_0 - chi2 >= 2 decisive). The evidence alone is not enough: it scores
+// the model as given at the noise alone, so an effect fitted to nothing (its parameter at the nominal value, the
+// misfit unchanged) can be "decisive" where the misfit's scale is above the noise (dev split: self weight at
+// load factor 0 +- 8, chi2 100.9 -> 100.9, ln BF 22).
+bool admissible(const Problem& p, const SetFit& f, const FitQuality& before) {
+  if (!f.ok || f.at_bound) return false;
+  if (f.quality.max_freq_error_pct > before.max_freq_error_pct ||
+      f.quality.mean_mac < before.mean_mac - mac_tolerance(p))
+    return false;
+  if (2 * f.parameters() > std::max(2, p.modes)) return false;
+  for (std::size_t k = 0; k < f.set.size(); ++k)
+    if (significance(p, f, k) < p.options.min_significance &&
+        !(f.set.size() == 1 && log_evidence(p, f) >= p.options.decisive && p.chi2_0 - f.chi2 >= 2 * p.options.decisive))
+      return false;
+  return true;
+}
+
+namespace {
+
 struct Search {
   const Problem& p;
   FitQuality before;
@@ -72,27 +98,7 @@ struct Search {
   double evidence(const SetFit& f) const { return log_evidence(p, f); }
   // Share of the misfit removed, relative to the best any explored set reached (reported).
   double explained(const SetFit& f) const { return explained_share(p, f, chi2_best); }
-  // A set that may stand as an explanation: fitted, inside its bounds, no worse than the model as given in its
-  // largest frequency error or its mean MAC (to mac_tolerance), every effect significant, at most one
-  // parameter per two measured modes. Significant: the magnitude's Wald z; a lone effect whose posterior is too
-  // far from normal for a Wald test (a support spring towards pinned, where the frequencies stop seeing the
-  // flexibility) is significant when it is decisive against the model as given by its evidence and by the
-  // likelihood ratio at the data's noise (chi2_0 - chi2 >= 2 decisive). The evidence alone is not enough: it scores
-  // the model as given at the noise alone, so an effect fitted to nothing (its parameter at the nominal value, the
-  // misfit unchanged) can be "decisive" where the misfit's scale is above the noise (dev split: self weight at
-  // load factor 0 +- 8, chi2 100.9 -> 100.9, ln BF 22).
-  bool admissible(const SetFit& f) const {
-    if (!f.ok || f.at_bound) return false;
-    if (f.quality.max_freq_error_pct > before.max_freq_error_pct ||
-        f.quality.mean_mac < before.mean_mac - mac_tolerance(p))
-      return false;
-    if (2 * f.parameters() > std::max(2, p.modes)) return false;
-    for (std::size_t k = 0; k < f.set.size(); ++k)
-      if (significance(p, f, k) < p.options.min_significance &&
-          !(f.set.size() == 1 && evidence(f) >= p.options.decisive && p.chi2_0 - f.chi2 >= 2 * p.options.decisive))
-        return false;
-    return true;
-  }
+  bool admissible(const SetFit& f) const { return internal::admissible(p, f, before); }
   // Whether adding one effect to `from` (giving `to`) is worth it: decisive, removing `further` of the misfit
   // `from` leaves (beyond what the best explored set leaves) and `min_share` of the model's as given.
   bool worth(const SetFit& from, const SetFit& to) const {

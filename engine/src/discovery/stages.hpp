@@ -146,5 +146,29 @@ struct Selection {
   int eigen_solves = 0;
 };
 Selection select(const Problem& p, const std::vector<SetFit>& singles, const FitQuality& before);
+/// The findings' probability among the explanations scored (equal prior odds over them; the model as given is
+/// one of them at ln evidence 0): each other explanation, by its relation to the findings and its ln evidence.
+struct StoryOdds {
+  enum class Relation {
+    kSameStory,  ///< the findings' story at an equivalent site, or by a kind of the same physics: counts for them
+    kSameKinds,  ///< the findings' kinds elsewhere
+    kOther,      ///< another physics (`kinds`), or no physics (empty `kinds`: the recalibration of E and rho)
+  };
+  struct Entry {
+    Relation relation = Relation::kOther;
+    double log_evidence = 0;
+    std::vector<std::string> kinds;
+  };
+  double probability = 0;        ///< the findings, with their equivalent sites
+  double kind_probability = 0;   ///< their kinds anywhere (= probability when another site of them is more probable)
+  int other = -1;                ///< entry of the best explanation of the most probable other physics (-1: none)
+  double other_probability = 0;  ///< that physics' probability, summed over its sites and explanations
+};
+/// `best`: the findings' ln evidence.
+StoryOdds story_odds(double best, const std::vector<StoryOdds::Entry>& entries);
+
+/// Whether a fitted set may stand as an explanation (select.cpp: inside its bounds, no worse than the model as
+/// given, every effect significant, at most one parameter per two measured modes).
+bool admissible(const Problem& p, const SetFit& f, const FitQuality& before);
 
 }  // namespace dynid::internal
