@@ -248,7 +248,6 @@ TEST(DiscoveryStages, AnEffectFittedToNothingIsNoFinding) {
   EXPECT_GT(tested, 0) << "no global candidate's nothing-fit passed the evidence test: the case does not test the rule";
 }
 
-// Nothing missing: the data are the analysis model's own modes.
 // The findings' probability among the explanations (internal::story_odds), against hand-computed odds: with
 // findings at ln evidence 10, an equivalent site at 10 counts for them, a same-kind site elsewhere at 9 only for
 // their kinds, another physics at three sites (10, 10.2, 10) and the recalibration at 8 against. Exact arithmetic
@@ -279,6 +278,7 @@ TEST(DiscoveryStages, StoryOddsSumAPhysicsOverItsSites) {
   EXPECT_NEAR(o.other_probability, std::exp(-1.0) / (1 + std::exp(2.0) + std::exp(-1.0) + std::exp(-10.0)), 1e-12);
 }
 
+// Nothing missing: the data are the analysis model's own modes.
 TEST(Discovery, ExactDataOfTheModelIsConsistent) {
   const Model analysis = make_frame2d(portal());
   const ModalData meas = exact_modes(analysis, analysis, 6);

@@ -438,7 +438,7 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   const OtherPhysics other = explain(sel, &S);
   // The physics is what is asked: its probability is the sum over its sites and explanations. When the best
   // explanation's kinds are not the most probable story (rivals) and another physics is, on the same pool of
-  // explanations, that physics' best single-effect explanation is named instead (where stays uncertain: the
+  // explanations, that physics' best single-effect explanation is named instead (its site may stay uncertain: the
   // verdict then says so), provided it may stand as an explanation itself.
   if (S.verdict == Verdict::kInconclusive && S.reason == VerdictReason::kRivals && other.fit &&
       other.probability >= options.min_probability && other.fit->set.size() == 1 &&
