@@ -439,8 +439,12 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
   //    others, so that it never stands in for a mode they report.
   std::vector<std::vector<std::size_t>> kept;
   const ExpectedAtOutputs expected(o, s.dofs);
-  std::vector<const std::vector<std::size_t>*> weak;
-  std::vector<int> weak_expected;
+  struct Weak {
+    const std::vector<std::size_t>* group;
+    int expected;
+    double support;
+  };
+  std::vector<Weak> weak;
   for (const std::vector<std::size_t>& g : groups) {
     const Candidate& h = cands[g[0]];
     const double support = joint_support(cands, g, n_orders);
@@ -449,8 +453,7 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
     if (support < o.min_cluster_fraction) {
       const int e = support >= o.expected_fraction ? expected.match(h.cluster.frequency_hz, h.shape) : -1;
       if (e >= 0) {
-        weak.push_back(&g);
-        weak_expected.push_back(e);
+        weak.push_back({&g, e, support});
         continue;
       }
       for (std::size_t k : g) reject(cands[k].cluster, Rejection::kFewOrders, support, o.min_cluster_fraction);
@@ -465,18 +468,21 @@ std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate
     }
     if (ok) kept.push_back(g);
   }
-  for (std::size_t w = 0; w < weak.size(); ++w) {
-    const std::vector<std::size_t>& g = *weak[w];
-    const Candidate& h = cands[g[0]];
-    const double support = joint_support(cands, g, n_orders);
-    bool taken = false;  // a reported mode already is that model mode
-    for (const std::vector<std::size_t>& k : kept)
-      taken = taken || expected.match(cands[k[0]].cluster.frequency_hz, cands[k[0]].shape) == weak_expected[w];
-    const double mpc = modal_phase_collinearity(h.shape);
-    if (taken || mpc < o.min_mpc || ev[g[0]].peak_db < o.min_peak_db || ev[g[0]].edge_db > o.max_edge_db) {
-      for (std::size_t k : g) reject(cands[k].cluster, Rejection::kFewOrders, support, o.min_cluster_fraction);
+  // The model modes a reported mode already is (each reported mode matched once).
+  std::vector<char> taken(o.expected_modes.size(), 0);
+  for (const std::vector<std::size_t>& k : kept) {
+    const int e = expected.match(cands[k[0]].cluster.frequency_hz, cands[k[0]].shape);
+    if (e >= 0) taken[static_cast<std::size_t>(e)] = 1;
+  }
+  for (const Weak& w : weak) {
+    const std::vector<std::size_t>& g = *w.group;
+    const double mpc = modal_phase_collinearity(cands[g[0]].shape);
+    if (taken[static_cast<std::size_t>(w.expected)] || mpc < o.min_mpc || ev[g[0]].peak_db < o.min_peak_db ||
+        ev[g[0]].edge_db > o.max_edge_db) {
+      for (std::size_t k : g) reject(cands[k].cluster, Rejection::kFewOrders, w.support, o.min_cluster_fraction);
       continue;
     }
+    taken[static_cast<std::size_t>(w.expected)] = 1;
     kept.push_back(g);
   }
   // Ascending frequency (of the strongest cluster); the splits are listed against the mode they joined.

@@ -446,14 +446,7 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
     Selection e;
     e.fit = *other.fit;
     e.importance = {log_evidence(p, e.fit)};
-    SelectionStep st;
-    st.action = SelectionStep::Action::kStart;
-    st.description = e.fit.set[0]->description();
-    st.log_evidence = e.importance[0];
-    st.explained = explained_share(p, e.fit, sel.chi2_best);
-    st.max_freq_error_pct = e.fit.quality.max_freq_error_pct;
-    st.mean_mac = e.fit.quality.mean_mac;
-    e.steps = {st};
+    e.steps = {selection_step(p, SelectionStep::Action::kStart, e.fit.set[0]->description(), e.fit, sel.chi2_best)};
     e.alternatives.push_back(sel.fit);
     for (const SetFit& a : sel.alternatives)
       if (a.set != e.fit.set) e.alternatives.push_back(a);

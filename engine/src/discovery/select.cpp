@@ -52,6 +52,18 @@ bool admissible(const Problem& p, const SetFit& f, const FitQuality& before) {
   return true;
 }
 
+SelectionStep selection_step(const Problem& p, SelectionStep::Action a, const std::string& what, const SetFit& f,
+                             double chi2_best) {
+  SelectionStep st;
+  st.action = a;
+  st.description = what;
+  st.log_evidence = log_evidence(p, f);
+  st.explained = explained_share(p, f, chi2_best);
+  st.max_freq_error_pct = f.quality.max_freq_error_pct;
+  st.mean_mac = f.quality.mean_mac;
+  return st;
+}
+
 namespace {
 
 struct Search {
@@ -170,14 +182,7 @@ struct ChainResult {
 };
 
 SelectionStep step_of(const Search& s, SelectionStep::Action a, const std::string& what, const SetFit& f) {
-  SelectionStep st;
-  st.action = a;
-  st.description = what;
-  st.log_evidence = s.evidence(f);
-  st.explained = s.explained(f);
-  st.max_freq_error_pct = f.quality.max_freq_error_pct;
-  st.mean_mac = f.quality.mean_mac;
-  return st;
+  return selection_step(s.p, a, what, f, s.chi2_best);
 }
 
 // The set `f` without its k-th effect, and the start values of the others.

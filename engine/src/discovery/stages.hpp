@@ -170,5 +170,9 @@ StoryOdds story_odds(double best, const std::vector<StoryOdds::Entry>& entries);
 /// Whether a fitted set may stand as an explanation (select.cpp: inside its bounds, no worse than the model as
 /// given, every effect significant, at most one parameter per two measured modes).
 bool admissible(const Problem& p, const SetFit& f, const FitQuality& before);
+/// One step of the selection for the record: the set `f` after `what` was added, removed or started from, scored
+/// (its evidence, the share of the misfit it removes against chi2_best).
+SelectionStep selection_step(const Problem& p, SelectionStep::Action a, const std::string& what, const SetFit& f,
+                             double chi2_best);
 
 }  // namespace dynid::internal
