@@ -44,6 +44,21 @@ TEST(Correlation, PairingBreaksMacTiesByFrequency) {
   EXPECT_EQ(p.pairs[0].b, 1);
 }
 
+TEST(Correlation, PairingWeighsFrequencyLikeMac) {
+  // Two model modes alike at few sensors (a frame at 7 sensors: MAC 0.96 to each other): the measured mode's MAC
+  // of 0.92 with the one 15 % away and 0.90 with the one 2.5 % away cannot tell them apart; the frequency does
+  // (scores 0.92 - 0.15 against 0.90 - 0.025). A clear MAC difference still wins over a closer frequency.
+  Eigen::MatrixXd mac(1, 2);
+  mac << 0.92, 0.90;
+  Pairing p = pair_modes(mac, Eigen::VectorXd::Constant(1, 42.17), Eigen::Vector2d(36.55, 43.21));
+  ASSERT_EQ(p.pairs.size(), 1u);
+  EXPECT_EQ(p.pairs[0].b, 1);
+  mac << 0.95, 0.6;
+  p = pair_modes(mac, Eigen::VectorXd::Constant(1, 10.0), Eigen::Vector2d(11.0, 10.1));
+  ASSERT_EQ(p.pairs.size(), 1u);
+  EXPECT_EQ(p.pairs[0].b, 0);
+}
+
 TEST(Correlation, PairingRefusesPartnersMoreThanTwiceApart) {
   // Issue 16, item 5: a measured mode whose only similar model mode is 2.5x its frequency stays unpaired (a
   // spurious mode or a spatial alias), however high the MAC; one 1.9x away is still a partner (the bound is 2x).

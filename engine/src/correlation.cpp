@@ -103,7 +103,7 @@ Pairing pair_modes(const Eigen::MatrixXd& mac, const Eigen::VectorXd& fa, const 
       const double bound = max_ratio > 0 ? std::min(max_ratio, kMaxPairingRatio) : kMaxPairingRatio;
       if (freq && fa[i] > 0 && fb[j] > 0 && std::abs(std::log(fb[j] / fa[i])) > std::log(bound)) continue;
       const double df = freq && fa[i] > 0 ? std::min(1.0, std::abs(fb[j] - fa[i]) / fa[i]) : 0.0;
-      c.push_back({i, j, mac(i, j) - 0.1 * df});
+      c.push_back({i, j, mac(i, j) - kPairingFrequencyWeight * df});
     }
   std::stable_sort(c.begin(), c.end(), [](const Cand& x, const Cand& y) { return x.score > y.score; });
   std::vector<char> ua(na, 0), ub(nb, 0);
