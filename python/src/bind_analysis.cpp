@@ -214,25 +214,31 @@ void bind_analysis(py::module_& mod) {
   mod.def("mac", [](const Eigen::Ref<const Eigen::MatrixXd>& A, const Eigen::Ref<const Eigen::MatrixXd>& B) {
     return move_array(mac_matrix(A, B));
   }, py::arg("A"), py::arg("B"), "MAC matrix of the columns of A (dofs x ma) and B (dofs x mb).");
-  mod.def("pair_modes", [](const Eigen::Ref<const Eigen::MatrixXd>& mac, py::object fa, py::object fb, double min_mac, double max_ratio) {
-    const Pairing p = pair_modes(mac, fa.is_none() ? Eigen::VectorXd() : vec(fa, "fa"), fb.is_none() ? Eigen::VectorXd() : vec(fb, "fb"),
-                                 min_mac, max_ratio);
-    py::list pairs;
-    for (const ModePair& q : p.pairs) {
-      py::dict d;
-      d["a"] = q.a;
-      d["b"] = q.b;
-      d["mac"] = q.mac;
-      d["freq_error"] = q.freq_error;
-      pairs.append(d);
-    }
-    py::dict d;
-    d["pairs"] = pairs;
-    d["unpaired_a"] = p.unpaired_a;
-    d["unpaired_b"] = p.unpaired_b;
-    return d;
-  }, py::arg("mac"), py::arg("fa") = py::none(), py::arg("fb") = py::none(), py::arg("min_mac") = 0.5, py::arg("max_ratio") = 0.0,
-     "One-to-one pairing of the columns of A and B by MAC (correlation.hpp).");
+  mod.def(
+      "pair_modes",
+      [](const Eigen::Ref<const Eigen::MatrixXd>& mac, py::object fa, py::object fb, double min_mac, double max_ratio) {
+        const Pairing p = pair_modes(mac, fa.is_none() ? Eigen::VectorXd() : vec(fa, "fa"),
+                                     fb.is_none() ? Eigen::VectorXd() : vec(fb, "fb"), min_mac, max_ratio);
+        py::list pairs;
+        for (const ModePair& q : p.pairs) {
+          py::dict d;
+          d["a"] = q.a;
+          d["b"] = q.b;
+          d["mac"] = q.mac;
+          d["freq_error"] = q.freq_error;
+          pairs.append(d);
+        }
+        py::dict d;
+        d["pairs"] = pairs;
+        d["unpaired_a"] = p.unpaired_a;
+        d["unpaired_b"] = p.unpaired_b;
+        return d;
+      },
+      py::arg("mac"), py::arg("fa") = py::none(), py::arg("fb") = py::none(), py::arg("min_mac") = 0.5,
+      py::arg("max_ratio") = 0.0,
+      "One-to-one pairing of the columns of A and B by the score MAC - |f_b - f_a| / f_a when frequencies fa, fb are "
+      "given (a per cent of frequency weighs like 0.01 of MAC; partners more than 2x apart never pair), by MAC alone "
+      "otherwise (correlation.hpp).");
   mod.def("serep", [](const Eigen::Ref<const Eigen::MatrixXd>& Phi, const Eigen::Ref<const Eigen::VectorXd>& lambda, std::vector<int> masters,
                       double rcond) {
     SerepReduction s;
