@@ -281,15 +281,10 @@ OtherPhysics weigh_rivals(const Problem& p, const Selection& sel, const std::vec
   for (const SetFit& f : singles)
     if (f.ok && !f.at_bound) others.push_back(&f);
   // A set reached twice (two starts, a chain of one) counts once; the findings' own set not at all.
-  auto key_of = [](const std::vector<const Candidate*>& a) {
-    std::vector<const Candidate*> key(a.begin(), a.end());
-    std::sort(key.begin(), key.end());
-    return key;
-  };
-  std::set<std::vector<const Candidate*>> seen = {key_of(sel.fit.set)};
+  std::set<std::vector<const Candidate*>> seen = {set_key(sel.fit.set)};
   std::vector<StoryOdds::Entry> entries;
   for (const SetFit* a : others) {
-    if (a->set.size() > sel.fit.set.size() || !seen.insert(key_of(a->set)).second) continue;
+    if (a->set.size() > sel.fit.set.size() || !seen.insert(set_key(a->set)).second) continue;
     const double le = log_evidence(p, *a);
     const std::vector<std::string> kinds = kinds_of(a->set);
     const StoryOdds::Relation rel = !other_story(a->set)   ? StoryOdds::Relation::kSameStory

@@ -39,6 +39,11 @@ double mac_tolerance(const Problem& p) { return std::clamp(0.5 * p.noise.shape *
 // the model as given at the noise alone, so an effect fitted to nothing (its parameter at the nominal value, the
 // misfit unchanged) can be "decisive" where the misfit's scale is above the noise (dev split: self weight at
 // load factor 0 +- 8, chi2 100.9 -> 100.9, ln BF 22).
+std::vector<const Candidate*> set_key(std::vector<const Candidate*> s) {
+  std::sort(s.begin(), s.end());
+  return s;
+}
+
 bool admissible(const Problem& p, const SetFit& f, const FitQuality& before) {
   if (!f.ok || f.at_bound) return false;
   if (f.quality.max_freq_error_pct > before.max_freq_error_pct ||
@@ -71,19 +76,15 @@ struct Search {
   FitQuality before;
   double chi2_best = 0;
   int solves = 0;
-  std::map<std::vector<const Candidate*>, SetFit> cache{};  // by the set's candidates, sorted
+  std::map<std::vector<const Candidate*>, SetFit> cache{};  // by set_key
 
-  static std::vector<const Candidate*> key(std::vector<const Candidate*> s) {
-    std::sort(s.begin(), s.end());
-    return s;
-  }
   const SetFit* find(const std::vector<const Candidate*>& s) const {
-    const auto it = cache.find(key(s));
+    const auto it = cache.find(set_key(s));
     return it == cache.end() ? nullptr : &it->second;
   }
   void store(const SetFit& f) {
     solves += f.evaluations;
-    cache.emplace(key(f.set), f);
+    cache.emplace(set_key(f.set), f);
   }
   // Fits the sets not fitted yet (in parallel), each from its start values.
   void fit_all(const std::vector<std::vector<const Candidate*>>& sets, const std::vector<std::vector<Eigen::VectorXd>>& starts) {
@@ -288,7 +289,7 @@ void choose(const Search& s, std::vector<ChainResult>& results) {
 
 Selection select(const Problem& p, const std::vector<SetFit>& singles, const FitQuality& before) {
   Search s{p, before};
-  for (const SetFit& f : singles) s.cache.emplace(Search::key(f.set), f);
+  for (const SetFit& f : singles) s.cache.emplace(set_key(f.set), f);
   s.update_best();
   std::vector<std::vector<const SetFit*>> chains;
   for (const SetFit* st : starts_of(s, singles)) chains.push_back(grow(s, st));

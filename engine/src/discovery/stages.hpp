@@ -167,6 +167,9 @@ struct StoryOdds {
 /// `best`: the findings' ln evidence.
 StoryOdds story_odds(double best, const std::vector<StoryOdds::Entry>& entries);
 
+/// A set of candidates in a canonical order (by address): the same set, however reached, has the same key.
+std::vector<const Candidate*> set_key(std::vector<const Candidate*> s);
+
 /// Whether a fitted set may stand as an explanation (select.cpp: inside its bounds, no worse than the model as
 /// given, every effect significant, at most one parameter per two measured modes).
 bool admissible(const Problem& p, const SetFit& f, const FitQuality& before);
