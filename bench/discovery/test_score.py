@@ -1,0 +1,64 @@
+#!/usr/bin/python3
+"""Checks of the benchmark's scoring (score.py) and its rates (run.py summarize). Run: python3 test_score.py
+
+Small hand-made truth and result records; each check says what it guards against.
+"""
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import run  # noqa: E402
+import score  # noqa: E402
+
+
+def truth(kind="support_spring", source="modal", sigma_f=0.001, shifts=(2.0,), node=7):
+    effects = [dict(kind=kind, description=f"effect {k}", shift_pct=s,
+                    accept={"kinds": ["grounded_spring"], "nodes": [node], "global": False},
+                    reference=dict(grounded_spring=dict(parameter="stiffness", unit="N/m", value=1e6)))
+               for k, s in enumerate(shifts)]
+    return dict(case=f"t-{kind}-{source}", kind=kind, source=source, family="cantilever", effects=effects,
+                null_accept=["consistent"], element_lengths={},
+                data=dict(frequency_noise=sigma_f) if source == "modal" else dict(excitation="impact"))
+
+
+def found(node, value=1.05e6, std=1e5):
+    return dict(verdict="missing_physics", probability=0.9,
+                findings=[dict(kind="grounded_spring", location=dict(nodes=[node], elements=[]),
+                               parameters=dict(stiffness=value), std=dict(stiffness=std), units=dict(stiffness="N/m"),
+                               description=f"node {node} is restrained elastically")],
+                fit=dict(before=dict(max_freq_error_pct=2.0, mean_mac=0.99),
+                         after=dict(max_freq_error_pct=0.1, mean_mac=0.995)))
+
+
+def check(name, ok):
+    print(("ok   " if ok else "FAIL ") + name)
+    return ok
+
+
+def main():
+    ok = True
+    # The floor is max(0.5 %, 5 sigma_f) with the generator's 5 % slack: 5 x 0.2 % = 1 % here.
+    ok &= check("floor of modal data is 5 sigma_f above 0.5 %", abs(score.shift_floor_pct(truth(sigma_f=0.002)) - 1.0) < 1e-12)
+    ok &= check("floor of recordings is 0.5 %", score.shift_floor_pct(truth(source="recordings")) == 0.5)
+    ok &= check("an effect at 0.96 % of a 1 % floor is in spec", not score.below_floor(truth(sigma_f=0.002, shifts=(0.96,))))
+    ok &= check("an effect at 0.94 % of a 1 % floor is below it", score.below_floor(truth(sigma_f=0.002, shifts=(0.94,))))
+    ok &= check("two effects: one below the floor flags the case", score.below_floor(truth(shifts=(3.0, 0.1))))
+    ok &= check("a null case is never below the floor", not score.below_floor(dict(truth(), kind="null", effects=[])))
+
+    # Rates: a case below the floor leaves the named-right denominator; the others count as before.
+    right = score.score(truth(shifts=(2.0,)), found(7))
+    wrong = score.score(truth(shifts=(2.0,)), found(9))
+    low = score.score(truth(shifts=(0.1,)), dict(verdict="consistent", findings=[]))
+    ok &= check("named right at the accepted node, within 10 %", right["named_right"] and right["within"] and right["covered"])
+    ok &= check("another node is not named right", not wrong["named_right"])
+    ok &= check("the weak effect is flagged and not named right", low["below_floor"] and not low["named_right"])
+    s = run.summarize([right, wrong, low])
+    ok &= check("named-right rate over the 2 cases in spec (1 of 2)", s["nonnull"] == 2 and abs(s["named_right"] - 0.5) < 1e-12)
+    ok &= check("below-floor count reported", s["below_floor"] == 1)
+    s_all = run.summarize([right, wrong])
+    ok &= check("without flagged cases the rates are unchanged", s_all["named_right"] == s["named_right"])
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
