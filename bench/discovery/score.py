@@ -27,6 +27,9 @@ import math
 import sys
 
 TOLERANCE = 0.10
+# A finding "worsens" the fit when the max frequency error grows by more than 0.1 % of itself or the mean MAC
+# falls by more than 0.001 (below that: the rounding of a fit to noisy shapes; `worsened_strict` counts any change).
+WORSE_FREQ, WORSE_MAC = 1e-3, 1e-3
 SHIFT_MIN_PCT = 0.5     # generate.py's SHIFT_MIN, in %
 FLOOR_SLACK = 0.95      # generate.py keeps a draw when every effect reaches 0.95 of the lower bound
 
@@ -44,9 +47,6 @@ def below_floor(truth):
         return False
     floor = FLOOR_SLACK * shift_floor_pct(truth)
     return any(e["shift_pct"] < floor for e in truth["effects"])
-# A finding "worsens" the fit when the max frequency error grows by more than 0.1 % of itself or the mean MAC
-# falls by more than 0.001 (below that: the rounding of a fit to noisy shapes; `worsened_strict` counts any change).
-WORSE_FREQ, WORSE_MAC = 1e-3, 1e-3
 
 
 def site_matches(finding, accept):
