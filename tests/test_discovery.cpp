@@ -602,6 +602,31 @@ TEST(Candidates, PreloadOnlyWhereALackOfFitMeetsARestraint) {
                                    "axial preload (geometric stiffness) in the members of group 'beam'"}));
 }
 
+// A support's stiffness against the model's idealisation is one physics, seen from either side: a clamp less than
+// rigid (flexible_support) or a pin more than free (rotational_spring, only at supported nodes). On a simply
+// supported beam the rotational springs are the two pins' and share flexible_support's physics; the translational
+// springs to ground (bracing anywhere) keep their own.
+TEST(Candidates, ASupportsFixityIsOnePhysics) {
+  BeamSpec b = square_steel_beam(2.0);
+  b.elements = 8;
+  b.support = BeamSupport::SimplySupported;
+  const Model m = make_beam(b);
+  std::set<int> pins;
+  std::set<std::string> grounded;
+  for (const auto& c : candidate_library(m, exact_modes(m, m, 3), DiscoveryOptions{})) {
+    if (c->kind() == "rotational_spring") {
+      pins.insert(c->site().nodes.at(0));
+      EXPECT_EQ(c->physics(), "flexible_support") << c->description();
+    }
+    if (c->kind() == "flexible_support") {
+      EXPECT_EQ(c->physics(), "flexible_support") << c->description();
+    }
+    if (c->kind() == "grounded_spring") grounded.insert(c->physics());
+  }
+  EXPECT_EQ(pins, (std::set<int>{m.nodes().front().id, m.nodes()[static_cast<std::size_t>(b.elements)].id}));
+  EXPECT_EQ(grounded, std::set<std::string>{"grounded_spring"});
+}
+
 }  // namespace
 }  // namespace dynid
 

@@ -11,6 +11,10 @@ class GroundedSpring : public Candidate {
     eq_ = m.dof_map().eq(node, d);
   }
   std::string kind() const override { return is_rotation(dof_) ? "rotational_spring" : "grounded_spring"; }
+  // A rotational spring sits at a support (place(), below): a pin or a roller partly fixed. That is the physics of
+  // flexible_support, the support's true stiffness against the model's idealisation, seen from the other side (a
+  // clamp less than rigid there, a pin more than free here): one physics, its sites pooled.
+  std::string physics() const override { return is_rotation(dof_) ? "flexible_support" : kind(); }
   Nature nature() const override { return Nature::kStiffness; }
   std::string description() const override {
     return std::string(is_rotation(dof_) ? "rotational" : "translational") + " spring to ground on " +
