@@ -196,14 +196,17 @@ def table(rep, cases, checks, meta):
         if b:
             lines.append(f"| {lo:g}–{min(hi, 1):g} | {len(b)} | {pct(sum(c['probability'] for c in b) / len(b))} | "
                          f"{pct(sum(c['named_right'] for c in b) / len(b))} |")
+    def truth_and_said(c, width):
+        truth = "null" if c["null"] else "; ".join(c.get("truth_effects", [])) or c["kind"]
+        return f"{c['kind']}: {truth}", c["said"].replace("|", "/").replace("\n", " ")[:width]
+
     lines += ["", "## Cases not right", "", "| case | truth | family | dynid said |", "|---|---|---|---|"]
     for c in cases:
         right = c["null_right"] if c["null"] else c["named_right"]
         if right or c.get("below_floor"):
             continue
-        truth = "null" if c["null"] else "; ".join(c.get("truth_effects", [])) or c["kind"]
-        said = c["said"].replace("|", "/").replace("\n", " ")
-        lines.append(f"| {c['case']} | {c['kind']}: {truth} | {c['family']} | {said[:400]} |")
+        truth, said = truth_and_said(c, 400)
+        lines.append(f"| {c['case']} | {truth} | {c['family']} | {said} |")
     floor = [c for c in cases if c.get("below_floor")]
     if floor:
         lines += ["", "## Cases below the shift floor (not in the named-right rates)", "",
@@ -211,10 +214,9 @@ def table(rep, cases, checks, meta):
                   "the generator kept its last draw when none reached it.", "",
                   "| case | truth | shift of the data's modes | lower bound | dynid said |", "|---|---|---|---|---|"]
         for c in floor:
-            truth = "; ".join(c.get("truth_effects", [])) or c["kind"]
-            said = c["said"].replace("|", "/").replace("\n", " ")
-            lines.append(f"| {c['case']} | {c['kind']}: {truth} | {c['effect_shift_pct']:.3g} % | "
-                         f"{c.get('shift_floor_pct', 0):.3g} % | {said[:200]} |")
+            truth, said = truth_and_said(c, 200)
+            lines.append(f"| {c['case']} | {truth} | {c['effect_shift_pct']:.3g} % | "
+                         f"{c.get('shift_floor_pct', 0):.3g} % | {said} |")
     return "\n".join(lines) + "\n"
 
 

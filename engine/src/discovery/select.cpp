@@ -30,6 +30,11 @@ double mac_tolerance(const Problem& p) { return std::clamp(0.5 * p.noise.shape *
 
 }  // namespace
 
+std::vector<const Candidate*> set_key(std::vector<const Candidate*> s) {
+  std::sort(s.begin(), s.end());
+  return s;
+}
+
 // A set that may stand as an explanation: fitted, inside its bounds, no worse than the model as given in its
 // largest frequency error or its mean MAC (to mac_tolerance), every effect significant, at most one
 // parameter per two measured modes. Significant: the magnitude's Wald z; a lone effect whose posterior is too
@@ -39,11 +44,6 @@ double mac_tolerance(const Problem& p) { return std::clamp(0.5 * p.noise.shape *
 // the model as given at the noise alone, so an effect fitted to nothing (its parameter at the nominal value, the
 // misfit unchanged) can be "decisive" where the misfit's scale is above the noise (dev split: self weight at
 // load factor 0 +- 8, chi2 100.9 -> 100.9, ln BF 22).
-std::vector<const Candidate*> set_key(std::vector<const Candidate*> s) {
-  std::sort(s.begin(), s.end());
-  return s;
-}
-
 bool admissible(const Problem& p, const SetFit& f, const FitQuality& before) {
   if (!f.ok || f.at_bound) return false;
   if (f.quality.max_freq_error_pct > before.max_freq_error_pct ||
