@@ -26,7 +26,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import effects as E          # noqa: E402
 import fe                    # noqa: E402
 import ideal                 # noqa: E402
-from modes import Modes, max_shift  # noqa: E402
+from modes import Modes, max_shift, seen_shift  # noqa: E402
 import structures as S       # noqa: E402
 import testdata as TD        # noqa: E402
 import truth as T            # noqa: E402
@@ -347,7 +347,9 @@ class Case:
                                self.labels)
             out.append(dict(kind=e.kind, variant=e.variant, description=e.describe(r["mag"]), magnitude=r["mag"],
                             accept=_accept_json(e.accept()), reference=_clean(e.reference(r["mag"])),
-                            shift_target_pct=100 * r["target"], shift_pct=100 * r["achieved"], ideal=diag))
+                            shift_target_pct=100 * r["target"], shift_pct=100 * r["achieved"],
+                            seen_shift_pct=100 * seen_shift(alone, self.null, alone.elastic(self.f_min)[:self.n_modes]),
+                            ideal=diag))
         return out
 
     def write(self, out_root):

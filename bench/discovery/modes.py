@@ -53,3 +53,22 @@ def max_shift(modes, ref, idx, min_mac=0.5):
         if M[j, r] >= min_mac:
             out = max(out, abs(modes.f[k] / ref.f[r] - 1))
     return out
+
+
+def seen_shift(modes, ref, idx, min_mac=0.5, sensor_mac=0.9):
+    """The shift a test can see: as max_shift, but each mode's shift is the smaller of its shift to the best-MAC
+    mode of `ref` over the measurable DOFs and to the best-MAC mode at the sensors (if that MAC is >= sensor_mac).
+    The two differ where the effect changes the motion of unmeasured parts: a tie rod's tension changes its own
+    wobble (most of X) but hardly the frame's modes at the sensors, and the X pairing then matches another mode."""
+    if modes.unstable:
+        return math.inf
+    MX = mac(modes.X[:, idx], ref.X)
+    MY = mac(modes.Y[:, idx], ref.Y)
+    out = 0.0
+    for j, k in enumerate(idx):
+        shifts = [abs(modes.f[k] / ref.f[r] - 1) for r, M, lo in ((int(MX[j].argmax()), MX, min_mac),
+                                                                  (int(MY[j].argmax()), MY, sensor_mac))
+                  if M[j, r] >= lo]
+        if shifts:
+            out = max(out, min(shifts))
+    return out

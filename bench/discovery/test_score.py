@@ -7,6 +7,9 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import numpy as np  # noqa: E402
+
+import modes  # noqa: E402
 import run  # noqa: E402
 import score  # noqa: E402
 
@@ -35,6 +38,27 @@ def check(name, ok):
     return ok
 
 
+class FakeModes:
+    """Modes with given frequencies, shapes over the measurable DOFs (X) and at the sensors (Y)."""
+    def __init__(self, f, X, Y):
+        self.f, self.X, self.Y, self.unstable = np.asarray(f, float), np.asarray(X, float), np.asarray(Y, float), False
+
+
+def check_seen_shift():
+    """Two modes; the sensors (the first two DOFs) see the frame, the last two DOFs are an unmeasured tie. The
+    effect changes the tie's part of mode 0 so much that over all DOFs it looks like the reference's mode 1."""
+    ref = FakeModes([10.0, 10.5], [[1, 0], [0, 1], [0, 5], [5, 0]], [[1, 0], [0, 1]])
+    tie = FakeModes([10.01, 10.52], [[1, 0], [0, 1], [5, 0], [0, 5]], [[1, 0], [0, 1]])
+    ok = check("max_shift pairs over all DOFs (the modes crossed: 5.2 %)",
+               abs(modes.max_shift(tie, ref, [0, 1]) - (10.52 / 10.0 - 1)) < 1e-12)
+    ok &= check("seen_shift pairs at the sensors when they agree better (0.19 %)",
+                abs(modes.seen_shift(tie, ref, [0, 1]) - (10.52 / 10.5 - 1)) < 1e-12)
+    same = FakeModes([10.3, 10.5], [[1, 0], [0, 1], [0, 5], [5, 0]], [[1, 0], [0, 1]])
+    ok &= check("where both pairings agree the shifts are equal (3 %)",
+                abs(modes.seen_shift(same, ref, [0, 1]) - modes.max_shift(same, ref, [0, 1])) < 1e-12)
+    return ok
+
+
 def main():
     ok = True
     # The floor is max(0.5 %, 5 sigma_f) with the generator's 5 % slack: 5 x 0.2 % = 1 % here.
@@ -44,6 +68,14 @@ def main():
     ok &= check("an effect at 0.94 % of a 1 % floor is below it", score.below_floor(truth(sigma_f=0.002, shifts=(0.94,))))
     ok &= check("two effects: one below the floor flags the case", score.below_floor(truth(shifts=(3.0, 0.1))))
     ok &= check("a null case is never below the floor", not score.below_floor(dict(truth(), kind="null", effects=[])))
+
+    # A tie rod's shift: the generator's pairing over all DOFs reads 160 %, the test sees 0.05 %.
+    tie = truth(sigma_f=0.002, shifts=(160.0,))
+    tie["effects"][0]["seen_shift_pct"] = 0.05
+    ok &= check("the shift a test can see decides the floor", score.below_floor(tie))
+    ok &= check("its shift is reported", score.score(tie, None, "x")["effect_shift_pct"] == 0.05)
+    ok &= check("without seen_shift_pct the calibrated shift decides", not score.below_floor(truth(shifts=(2.0,))))
+    ok &= check_seen_shift()
 
     # Rates: a case below the floor leaves the named-right denominator; the others count as before.
     right = score.score(truth(shifts=(2.0,)), found(7))
