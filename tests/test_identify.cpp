@@ -393,6 +393,50 @@ TEST(Selection, SecondReportOfAModeOnItsFlankIsMerged) {
 // few orders; with a model mode predicted at 1.05 (within expected_ratio 1.15) of the same shape it is a mode, at
 // its own frequency, and make_modes says which model mode it was reported as. Not with a predicted shape of MAC
 // 0.01 (< expected_mac 0.9), nor at 1.2 (beyond 1.15), nor when the cluster holds 10 % of the orders (< 0.2).
+// The band rule counts the model's modes until `modes` of them are visible at the sensors. Here 80 oscillators the
+// sensors cannot see (point masses on grounded springs, 0.5-2.1 Hz) lie below the cantilever's first mode (3.7 Hz),
+// as a frame's member modes can: the first 48 modes (the rule's first count for 8 wanted) hold none the sensors see.
+TEST(BandRule, CountsModesUntilEnoughAreVisible) {
+  BeamSpec b;
+  b.length = 1.5;
+  b.elements = 30;
+  b.material.E = 210e9;
+  b.material.rho = 7850;
+  b.section.A = 0.05 * 0.01;
+  b.section.Iz = 0.05 * 1e-6 / 12;
+  b.section.Iy = 0.01 * 1.25e-4 / 12;
+  b.section.J = b.section.Iy + b.section.Iz;
+  b.support = BeamSupport::Cantilever;
+  const Model beam = make_beam(b);
+  Model m = test::UnsupportedCopy(beam);
+  m.restrain(1, kAllDofs);
+  std::vector<MeasuredDof> sensors;
+  for (const Node& n : beam.nodes())
+    if (n.id % 3 == 0) sensors.push_back({n.id, Dof::UY});
+  ASSERT_GE(sensors.size(), 8u);
+  for (int i = 0; i < 80; ++i) {
+    const int id = 1000 + i;
+    m.add_node(id, Eigen::Vector3d(0.01 * i, -1.0, 0.0));
+    const double f = 0.5 + 0.02 * i, mass = 1.0;
+    Element pm;
+    pm.id = 5000 + i;
+    pm.type = ElementType::PointMass;
+    pm.num_nodes = 1;
+    pm.node_ids = {{id, 0}};
+    pm.mass = mass;
+    m.add_element(pm);
+    m.add_element(test::GroundedSpring(6000 + i, id, Dof::UY, mass * std::pow(2 * M_PI * f, 2)));
+    m.restrain(id, static_cast<DofMask>(kAllDofs & ~dof_bit(Dof::UY)));
+  }
+  m.finalize();
+  const ModelBand band = band_from_model(m, sensors, 5000, 8);
+  const ModelBand alone = band_from_model(beam, sensors, 5000, 8);
+  ASSERT_EQ(band.visible_hz.size(), 8u);
+  for (std::size_t k = 0; k < 8; ++k) EXPECT_TRUE(test::RelClose(band.visible_hz[k], alone.visible_hz[k], 1e-9)) << k;
+  EXPECT_NEAR(band.lo_hz, alone.lo_hz, 1e-9 * alone.lo_hz);
+  EXPECT_NEAR(band.hi_hz, alone.hi_hz, 1e-9 * alone.hi_hz);
+}
+
 TEST(Selection, WeakClusterShapedLikeAnExpectedModeIsReported) {
   SplitPair one(false);
   std::vector<internal::Candidate> weak{one.cands[0]};
