@@ -59,13 +59,20 @@ def run_case(job):
                     seconds_generate=time.time() - t0, seconds_dynid=0.0)
     t1 = time.time()
     out_json, out_png = Path(folder) / "discover.json", Path(folder) / "discover.png"
+    # A failed run leaves its message here and no discover.json, so that a rescore scores what this run did, never
+    # an older run's result.
+    out_failed = Path(folder) / "discover.failed"
     result, rc = None, None
     if a.get("rescore"):   # score the result dynid wrote before (a scoring or report change), never run it
-        if out_json.exists():
+        if out_failed.exists():
+            failure = out_failed.read_text().strip()
+        elif out_json.exists():
             result = json.loads(out_json.read_text())
         else:
             failure = "no discover.json"
     else:
+        for f in (out_json, out_png, out_failed):
+            f.unlink(missing_ok=True)
         cmd = [a["dynid"], "--threads", "1", "-q", "discover", str(folder), "--json", str(out_json),
                "--plot", str(out_png), "--force"]
         try:
@@ -78,6 +85,9 @@ def run_case(job):
                 failure = f"exit {rc}: {lines[-1] if lines else '(no message)'}"
         except subprocess.TimeoutExpired:
             failure = f"timeout after {a['timeout']} s"
+        if failure:
+            out_json.unlink(missing_ok=True)
+            out_failed.write_text(failure + "\n")
     t2 = time.time()
     sc = score.score(truth, result, failure)
     sc.update(exit_code=rc, seconds_generate=t1 - t0, seconds_dynid=t2 - t1,
