@@ -388,11 +388,6 @@ TEST(Selection, SecondReportOfAModeOnItsFlankIsMerged) {
   EXPECT_EQ(close.check().size(), 2u);
 }
 
-// IdentificationOptions::expected_modes: one resonance at 1 with a clear indicator peak, its cluster stable over
-// 30 % of the orders (below min_cluster_fraction 0.45, above expected_fraction 0.2). On its own it is rejected for
-// few orders; with a model mode predicted at 1.05 (within expected_ratio 1.15) of the same shape it is a mode, at
-// its own frequency, and make_modes says which model mode it was reported as. Not with a predicted shape of MAC
-// 0.01 (< expected_mac 0.9), nor at 1.2 (beyond 1.15), nor when the cluster holds 10 % of the orders (< 0.2).
 // The band rule counts the model's modes until `modes` of them are visible at the sensors. Here 80 oscillators the
 // sensors cannot see (point masses on grounded springs, 0.5-2.1 Hz) lie below the cantilever's first mode (3.7 Hz),
 // as a frame's member modes can: the first 48 modes (the rule's first count for 8 wanted) hold none the sensors see.
@@ -437,6 +432,11 @@ TEST(BandRule, CountsModesUntilEnoughAreVisible) {
   EXPECT_NEAR(band.hi_hz, alone.hi_hz, 1e-9 * alone.hi_hz);
 }
 
+// IdentificationOptions::expected_modes: one resonance at 1 with a clear indicator peak, its cluster stable over
+// 30 % of the orders (below min_cluster_fraction 0.45, above expected_fraction 0.2). On its own it is rejected for
+// few orders; with a model mode predicted at 1.05 (within expected_ratio 1.15) of the same shape it is a mode, at
+// its own frequency, and make_modes says which model mode it was reported as. Not with a predicted shape of MAC
+// 0.01 (< expected_mac 0.9), nor at 1.2 (beyond 1.15), nor when the cluster holds 10 % of the orders (< 0.2).
 TEST(Selection, WeakClusterShapedLikeAnExpectedModeIsReported) {
   SplitPair one(false);
   std::vector<internal::Candidate> weak{one.cands[0]};
