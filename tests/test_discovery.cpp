@@ -627,6 +627,32 @@ TEST(Candidates, ASupportsFixityIsOnePhysics) {
   EXPECT_EQ(grounded, std::set<std::string>{"grounded_spring"});
 }
 
+// The sensors' own mass: in SI units no sensor weighs more than 2 kg (the heaviest accelerometer with its mount), a
+// limit on what is plausible that leaves the bounds (and so the prior) as they are. A 157 kg steel beam measured at
+// its nodes: 1.9 kg per sensor is plausible, 2.1 kg is not; in model units both are.
+TEST(Candidates, SensorMassOfMoreThanTheHeaviestSensorIsImplausibleInSiUnits) {
+  BeamSpec b = square_steel_beam(2.0);
+  b.elements = 8;
+  b.support = BeamSupport::SimplySupported;
+  const Model m = make_beam(b);
+  for (const bool si : {true, false}) {
+    DiscoveryOptions o;
+    o.si_units = si;
+    int found = 0;
+    for (const auto& c : candidate_library(m, exact_modes(m, m, 3), o)) {
+      if (c->kind() != "sensor_mass") continue;
+      ++found;
+      const CandidateParameter q = c->parameters().at(0);
+      EXPECT_EQ(q.upper, 20.0);  // 40 % of the structure in all, SI or not
+      const double kg_per_unit = c->physical(Eigen::VectorXd::Ones(1), Eigen::VectorXd::Zero(1)).at(0).value;
+      ASSERT_LT(2.1 / kg_per_unit, q.upper);
+      EXPECT_TRUE(c->plausible(Eigen::VectorXd::Constant(1, 1.9 / kg_per_unit)));
+      EXPECT_EQ(c->plausible(Eigen::VectorXd::Constant(1, 2.1 / kg_per_unit)), !si);
+    }
+    EXPECT_EQ(found, 1);
+  }
+}
+
 }  // namespace
 }  // namespace dynid
 

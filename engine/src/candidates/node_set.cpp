@@ -1,13 +1,23 @@
 // sensor_mass and suspension_stiffness: equal point masses at the sensor nodes (accelerometers loading a light
 // structure) and equal springs at the suspension points of a free-free test (the test was not free).
+#include <limits>
+
 #include "candidates/common.hpp"
 
 namespace dynid::internal {
 namespace {
 
+// The heaviest sensor the sensor-mass candidate finds plausible (SI models): a seismic accelerometer with its
+// mounting block weighs up to about 1 kg, laboratory accelerometers 0.2-100 g. Tens of kilograms at every measured
+// node are not the sensors' mass, whatever else they are (a mass spread over a structure whose sensors are evenly
+// spaced). A limit on what is plausible, not a bound: the prior, normalised over the bounds, stays as it is.
+constexpr double kMaxSensorKg = 2.0;
+
 class NodeSet : public Candidate {
  public:
-  NodeSet(const Model& m, const std::vector<int>& nodes, bool springs, double ref) : springs_(springs), ref_(ref) {
+  NodeSet(const Model& m, const std::vector<int>& nodes, bool springs, double ref,
+          double most = std::numeric_limits<double>::infinity())
+      : springs_(springs), ref_(ref), most_(most) {
     for (int n : nodes) {
       std::vector<int> d;
       for (int t = 0; t < 3; ++t)
@@ -41,6 +51,7 @@ class NodeSet : public Candidate {
     }
     return out;
   }
+  bool plausible(const Eigen::VectorXd& th) const override { return ref_ * th[0] <= most_; }
   std::vector<PhysicalValue> physical(const Eigen::VectorXd& th, const Eigen::VectorXd& sd) const override {
     return {{springs_ ? "stiffness per point" : "mass per sensor", springs_ ? "N/m" : "kg", ref_ * th[0], ref_ * sd[0]}};
   }
@@ -51,7 +62,7 @@ class NodeSet : public Candidate {
 
  private:
   bool springs_;
-  double ref_;
+  double ref_, most_;
   std::vector<int> ids_;
   std::vector<std::vector<int>> dofs_;
 };
@@ -63,7 +74,8 @@ CandidateKind sensor_mass_kind() {
           [](const CandidateContext& c) {
             std::vector<std::unique_ptr<Candidate>> out;
             const double n = std::max<double>(1.0, static_cast<double>(c.sensor_nodes.size()));
-            auto s = std::make_unique<NodeSet>(*c.model, c.sensor_nodes, false, 0.02 * c.structure_mass / n);
+            auto s = std::make_unique<NodeSet>(*c.model, c.sensor_nodes, false, 0.02 * c.structure_mass / n,
+                                               c.si_units ? kMaxSensorKg : std::numeric_limits<double>::infinity());
             if (s->ok()) out.push_back(std::move(s));
             return out;
           }};

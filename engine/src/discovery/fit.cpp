@@ -102,6 +102,7 @@ SetFit fit_set(const Problem& p, const std::vector<const Candidate*>& set, const
     const double th = s.theta[first[k]], tol = 1e-6 * (ps[0].upper - ps[0].lower);
     if (std::abs(th - ps[0].lower) < tol && ps[0].lower != ps[0].nominal) out.at_bound = true;
     if (std::abs(th - ps[0].upper) < tol && ps[0].upper != ps[0].nominal) out.at_bound = true;
+    if (!set[k]->plausible(out.theta.back())) out.at_bound = true;
   }
   out.ok = true;
   out.unpartnered_gain = unpartnered_gain(p, pm, s.theta);

@@ -206,6 +206,7 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
                            modes, partner);
   p.context.measured = &p.data;
   p.context.gravity_acceleration = o.gravity_acceleration;
+  p.context.si_units = o.si_units;
   std::vector<CandidateKind> registry = builtin_candidate_kinds();
   registry.insert(registry.end(), o.extra_kinds.begin(), o.extra_kinds.end());
   p.library = place_candidates(p.context, registry, o.kinds);

@@ -62,7 +62,9 @@ struct SetFit {
   /// Sum over the unpartnered modes this set pairs of (log-density gain, prepare.cpp): evidence from modes the
   /// model as given lacks.
   double unpartnered_gain = 0;
-  bool at_bound = false;           ///< a magnitude (first) parameter ended on a bound
+  /// A magnitude (first) parameter ended on a bound, or a candidate's values are not plausible
+  /// (Candidate::plausible): either way no explanation.
+  bool at_bound = false;
   int evaluations = 0;
   int parameters() const;
 };

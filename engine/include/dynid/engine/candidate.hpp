@@ -76,6 +76,10 @@ class Candidate {
   virtual std::vector<PhysicalValue> physical(const Eigen::VectorXd& theta, const Eigen::VectorXd& std) const = 0;
   /// What was left out, in words, with the values ("the base at node 1 is not fixed: rotational spring ...").
   virtual std::string finding(const std::vector<PhysicalValue>& values) const = 0;
+  /// Whether fitted values (theta) are physically possible for what the candidate stands for, beyond its bounds
+  /// (which shape its prior): a fit outside is no explanation. Sensors of tens of kilograms are not the sensors'
+  /// mass. By default every value within the bounds.
+  virtual bool plausible(const Eigen::VectorXd& /*theta*/) const { return true; }
 };
 
 /// What a kind needs to place its candidates on a model, computed once per discovery: the model, the data and
@@ -103,6 +107,9 @@ struct CandidateContext {
   std::vector<int> suspension_nodes;   ///< free-free models: node indices of the suspension points
   Eigen::Vector3d gravity = Eigen::Vector3d(0, -1, 0);  ///< direction of gravity (unit)
   double gravity_acceleration = 9.81; ///< in the model's units (SI: m/s^2)
+  /// The model is in SI units (DiscoveryOptions::si_units): candidates about hardware of known size (sensors) may
+  /// judge their values in kg.
+  bool si_units = true;
 };
 
 /// A kind of candidate: its name (as in case files' `kinds:`), nature, a one-line summary, and how it places
