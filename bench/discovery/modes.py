@@ -42,17 +42,22 @@ def mac(a, b):
     return (a.T @ b) ** 2 / np.outer((a * a).sum(0), (b * b).sum(0))
 
 
+def _paired_shifts(modes, ref, idx, A, B, min_mac):
+    """Per mode k of idx, |f_k / f_ref - 1| to its best-MAC mode of `ref` (shapes A of `modes`, B of `ref`), or
+    None where that MAC is below min_mac."""
+    M = mac(A[:, idx], B)
+    out = []
+    for j, k in enumerate(idx):
+        r = int(M[j].argmax())
+        out.append(abs(modes.f[k] / ref.f[r] - 1) if M[j, r] >= min_mac else None)
+    return out
+
+
 def max_shift(modes, ref, idx, min_mac=0.5):
     """Largest |f / f_ref - 1| over the modes idx of `modes`, each paired with its best-MAC mode of `ref`."""
     if modes.unstable:
         return math.inf
-    M = mac(modes.X[:, idx], ref.X)
-    out = 0.0
-    for j, k in enumerate(idx):
-        r = int(M[j].argmax())
-        if M[j, r] >= min_mac:
-            out = max(out, abs(modes.f[k] / ref.f[r] - 1))
-    return out
+    return max((s for s in _paired_shifts(modes, ref, idx, modes.X, ref.X, min_mac) if s is not None), default=0.0)
 
 
 def seen_shift(modes, ref, idx, min_mac=0.5, sensor_mac=0.9):
@@ -62,13 +67,7 @@ def seen_shift(modes, ref, idx, min_mac=0.5, sensor_mac=0.9):
     wobble (most of X) but hardly the frame's modes at the sensors, and the X pairing then matches another mode."""
     if modes.unstable:
         return math.inf
-    MX = mac(modes.X[:, idx], ref.X)
-    MY = mac(modes.Y[:, idx], ref.Y)
-    out = 0.0
-    for j, k in enumerate(idx):
-        shifts = [abs(modes.f[k] / ref.f[r] - 1) for r, M, lo in ((int(MX[j].argmax()), MX, min_mac),
-                                                                  (int(MY[j].argmax()), MY, sensor_mac))
-                  if M[j, r] >= lo]
-        if shifts:
-            out = max(out, min(shifts))
-    return out
+    over_x = _paired_shifts(modes, ref, idx, modes.X, ref.X, min_mac)
+    at_sensors = _paired_shifts(modes, ref, idx, modes.Y, ref.Y, sensor_mac)
+    return max((min(s for s in pair if s is not None) for pair in zip(over_x, at_sensors) if pair != (None, None)),
+               default=0.0)
