@@ -74,6 +74,25 @@ TEST(CaseErrors, MisspelledDiscoveryKindIsNamed) {
             "(no error)");
 }
 
+// discover: gravity_acceleration is in the model's units and positive; without it and without units:, a model whose
+// materials read as mm, t, s (E in MPa, rho in t/mm^3) reports its values in model units (its masses are tonnes),
+// one in m, kg, s in SI.
+TEST(CaseErrors, GravityAndUnitsOfDiscovery) {
+  const std::string d = "discover:\n  measured: modes.uff\n";
+  const std::string e = Error(std::string(kGood) + d + "  gravity_acceleration: 0\n");
+  EXPECT_HAS(e, "case.yaml:16:");
+  EXPECT_HAS(e, "gravity_acceleration: expected the acceleration of gravity in the model's units");
+  const Case si = parse_case(std::string(kGood) + d, "case.yaml");
+  EXPECT_TRUE(si.discover->options.si_units);
+  EXPECT_EQ(si.discover->options.gravity_acceleration, 0.0);  // from the materials' units, when discovery runs
+  const std::string mm_model =
+      Replace(Replace(kGood, "E: 2.1e11, rho: 7800", "E: 2.1e5, rho: 7.8e-9"), "[2, 0, 1]", "[2, 0, 1000]");
+  const Case mm = parse_case(mm_model + d + "  gravity_acceleration: 9810\n", "case.yaml");
+  EXPECT_FALSE(mm.discover->options.si_units);
+  EXPECT_EQ(mm.discover->options.gravity_acceleration, 9810.0);
+  EXPECT_TRUE(parse_case(mm_model + d + "  units: si\n", "case.yaml").discover->options.si_units);  // as stated
+}
+
 TEST(CaseErrors, UnknownElementType) {
   const std::string e = Error(Replace(kGood, "element: frame2d", "element: frame4d"));
   EXPECT_HAS(e, "case.yaml:3:");

@@ -14,6 +14,7 @@
 #include "dynid/engine/modal.hpp"
 #include "dynid/io/discover_io.hpp"
 #include "dynid/mesh/generators.hpp"
+#include "dynid/mesh/units.hpp"
 #include "test_util.hpp"
 
 namespace dynid {
@@ -651,6 +652,46 @@ TEST(Candidates, SensorMassOfMoreThanTheHeaviestSensorIsImplausibleInSiUnits) {
     }
     EXPECT_EQ(found, 1);
   }
+}
+
+// Units are the user's: the portal in m, kg, s and in mm, t, s (E in MPa, rho in t/mm^3, A in mm^2, I in mm^4)
+// has the same eigenvalues, and its self_weight candidate at load factor 1 (the frame's own weight) moves them by
+// the same ratios: gravity is 9.81 m/s^2 in the first and 9810 mm/s^2 in the second, the unit read from the
+// materials' sqrt(E / rho) (mesh/units.hpp). Tolerance 1e-9 relative: the two models differ by powers of ten
+// only (rounding). Before, gravity was 9.81 in any units: the mm model's own weight was 1000 times too light and
+// its load factor of 1 a thousandth of the SI model's effect. Materials outside both ranges (E = rho = 1) or
+// disagreeing leave the unit unknown (metres assumed, said in the summary).
+TEST(Candidates, SelfWeightTakesGravityInTheModelsUnits) {
+  Frame2DSpec mm = portal();
+  mm.span *= 1e3;
+  mm.height *= 1e3;
+  mm.material.E *= 1e-6;     // Pa -> N/mm^2
+  mm.material.rho *= 1e-12;  // kg/m^3 -> t/mm^3
+  mm.column.A *= 1e6;
+  mm.column.Iz *= 1e12;
+  mm.beam.A *= 1e6;
+  mm.beam.Iz *= 1e12;
+  const Model si_model = make_frame2d(portal()), mm_model = make_frame2d(mm);
+  EXPECT_TRUE(length_unit(si_model).known);
+  EXPECT_EQ(length_unit(si_model).per_metre, 1.0);
+  EXPECT_TRUE(length_unit(mm_model).known);
+  EXPECT_EQ(length_unit(mm_model).per_metre, 1000.0);
+  Frame2DSpec odd = portal();
+  odd.material.E = odd.material.rho = 1;
+  EXPECT_FALSE(length_unit(make_frame2d(odd)).known);
+
+  std::vector<Eigen::VectorXd> ratio;
+  for (const Model* m : {&si_model, &mm_model}) {
+    for (const auto& c : candidate_library(*m, exact_modes(*m, *m, 4), DiscoveryOptions{})) {
+      if (c->kind() != "self_weight") continue;
+      const Eigen::VectorXd nominal = eigen_with(*m, *c, Eigen::VectorXd::Zero(1), 4);
+      ratio.push_back(eigen_with(*m, *c, Eigen::VectorXd::Ones(1), 4).cwiseQuotient(nominal));
+      EXPECT_LT(ratio.back().minCoeff(), 1 - 1e-6) << "the own weight softens the sway modes";
+    }
+  }
+  ASSERT_EQ(ratio.size(), 2u);
+  EXPECT_LT((ratio[0] - ratio[1]).cwiseAbs().maxCoeff(), 1e-9)
+      << ratio[0].transpose() << " vs " << ratio[1].transpose();
 }
 
 }  // namespace

@@ -5,14 +5,15 @@
 #include "dynid/io/case_file.hpp"
 #include "dynid/io/discover_io.hpp"
 #include "dynid/io/mat_file.hpp"
-#include "dynid/io/results_json.hpp"
 #include "dynid/io/modal_data_io.hpp"
+#include "dynid/io/results_json.hpp"
 #include "dynid/io/test_data.hpp"
 #include "dynid/io/test_layout.hpp"
 #include "dynid/io/uff.hpp"
+#include "dynid/mesh/units.hpp"
 #include "internal/case_util.hpp"
-#include "internal/text_util.hpp"
 #include "internal/model_yaml.hpp"
+#include "internal/text_util.hpp"
 
 namespace fs = std::filesystem;
 
@@ -56,8 +57,10 @@ DiscoverSpec::Expect parse_expect(const YAML::Node& n, const YamlCtx& ctx, bool 
 DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir,
                             const ReaderLimits& limits) {
   ctx.require_map(n, "discover");
-  ctx.only_keys(n, "discover", {"measured", "geometry", "recordings", "identify", "truth", "modes", "min_mpc", "frequency_noise", "shape_noise",
-                                "kinds", "sensor_nodes", "suspension_nodes", "max_effects", "screen", "seeds", "expect", "units", "gravity"});
+  ctx.only_keys(n, "discover",
+                {"measured", "geometry", "recordings", "identify", "truth", "modes", "min_mpc", "frequency_noise",
+                 "shape_noise", "kinds", "sensor_nodes", "suspension_nodes", "max_effects", "screen", "seeds", "expect",
+                 "units", "gravity", "gravity_acceleration"});
   DiscoverSpec d;
   const int sources = !!n["measured"] + !!n["recordings"] + !!n["truth"];
   if (sources != 1) ctx.fail(n, "discover: give exactly one of measured: FILE (modal data), recordings: [FILES] or truth: {model:, test:}");
@@ -169,10 +172,21 @@ DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model
   if (n["max_effects"]) o.max_effects = ctx.integer(n["max_effects"], "discover max_effects");
   if (n["screen"]) o.screen_fit = ctx.integer(n["screen"], "discover screen");
   if (n["seeds"]) d.seeds = ctx.integer(n["seeds"], "discover seeds");
+  if (n["gravity_acceleration"]) {
+    o.gravity_acceleration = ctx.number(n["gravity_acceleration"], "discover gravity_acceleration");
+    if (!(o.gravity_acceleration > 0))
+      ctx.fail(n["gravity_acceleration"],
+               "discover gravity_acceleration: expected the acceleration of gravity in the model's units (> 0; 9.81 in "
+               "m/s^2, 9810 in mm/s^2)");
+  }
   if (n["units"]) {
     const std::string u = ctx.string(n["units"], "discover units");
     if (u != "si" && u != "other") ctx.fail(n["units"], "discover: units must be si (values labelled kg, N, m) or other (model units)");
     o.si_units = u == "si";
+  } else {
+    // Not stated: SI unless the materials put the model in millimetres (mesh/units.hpp), whose masses are tonnes.
+    const LengthUnit unit = length_unit(model);
+    o.si_units = !(unit.known && unit.per_metre != 1);
   }
   if (d.seeds < 1) ctx.fail(n["seeds"], "discover: seeds must be >= 1");
   if (d.seeds > 1 && !d.truth) ctx.fail(n["seeds"], "discover: seeds (a robustness study) needs a truth: model");

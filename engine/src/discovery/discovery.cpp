@@ -58,7 +58,8 @@ bool DiscoveryOptions::IsValid(std::string* why) const {
   if (max_iterations < 1) return fail("max_iterations must be >= 1");
   if (!(min_mac > 0 && min_mac < 1)) return fail("min_mac must be in (0, 1)");
   if (!(max_frequency_ratio > 1)) return fail("max_frequency_ratio must be > 1");
-  if (!gravity.allFinite() || !(gravity_acceleration > 0)) return fail("gravity must be finite, its acceleration > 0");
+  if (!gravity.allFinite() || !(gravity_acceleration >= 0))
+    return fail("gravity must be finite, its acceleration >= 0 (0: from the model's units)");
   for (const CandidateKind& k : extra_kinds)
     if (k.name.empty() || !k.place) return fail("every extra candidate kind needs a name and a place function");
   return true;

@@ -8,6 +8,7 @@
 #include "discovery/stages.hpp"
 #include "dynid/engine/modal.hpp"
 #include "dynid/mesh/error.hpp"
+#include "dynid/mesh/units.hpp"
 
 namespace dynid::internal {
 
@@ -205,11 +206,24 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
   p.context = make_context(model, p.data.num_modes() ? p.data : measured, o.sensor_nodes, o.suspension_nodes, o.gravity,
                            modes, partner);
   p.context.measured = &p.data;
-  p.context.gravity_acceleration = o.gravity_acceleration;
+  const LengthUnit unit = length_unit(model);
+  p.context.gravity_acceleration = o.gravity_acceleration > 0 ? o.gravity_acceleration : gravity_acceleration(unit);
   p.context.si_units = o.si_units;
   std::vector<CandidateKind> registry = builtin_candidate_kinds();
   registry.insert(registry.end(), o.extra_kinds.begin(), o.extra_kinds.end());
   p.library = place_candidates(p.context, registry, o.kinds);
+  if (!(o.gravity_acceleration > 0) &&
+      std::any_of(p.library.begin(), p.library.end(), [](const auto& c) { return c->kind() == "self_weight"; })) {
+    if (!unit.known)
+      S->warnings.push_back(
+          "the materials do not say the model's length unit (slowest sqrt(E / rho) " + fmt_value(unit.wave_speed, 3) +
+          " per s; metres: 1,000-12,000, millimetres: 1e6-1.2e7): " +
+          "self_weight takes gravity as 9.81 (m/s^2); give discover: gravity_acceleration in the model's units");
+    else if (unit.per_metre != 1)
+      S->warnings.push_back("the materials (slowest sqrt(E / rho) " + fmt_value(unit.wave_speed, 3) + " " + unit.name +
+                            "/s) put the model in " + unit.name + ": self_weight takes gravity as " +
+                            fmt_value(p.context.gravity_acceleration, 4) + " " + unit.name + "/s^2");
+  }
   for (auto& c : extra) p.library.push_back(std::move(c));
   p.recalibration = make_recalibration(model);
   for (const auto& c : p.library) ++p.sites_per_physics[c->physics()];

@@ -83,7 +83,10 @@ struct DiscoveryOptions {
   std::vector<int> sensor_nodes;   ///< nodes carrying sensors (sensor mass loading); empty = the measured nodes
   std::vector<int> suspension_nodes;  ///< free-free tests: suspension points (empty = the two farthest nodes)
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< direction (zero: -y for plane models, -z for space ones)
-  double gravity_acceleration = 9.81;                 ///< in the model's units
+  /// The acceleration of gravity in the model's units (self_weight's loads); 0 = 9.81 m/s^2 in the length unit
+  /// the model's materials imply (mesh/units.hpp: metres or millimetres; metres when they do not say, with a
+  /// warning in the summary when the library holds a self_weight candidate).
+  double gravity_acceleration = 0;
   bool si_units = true;            ///< label reported values in SI (kg, N, m); false: "(model units)"
   bool IsValid(std::string* why) const;
 };
