@@ -7,6 +7,7 @@
 #include <cmath>
 #include <set>
 
+#include "candidates/registry.hpp"
 #include "discovery/stages.hpp"
 #include "dynid/engine/candidate_checks.hpp"
 #include "dynid/engine/discovery.hpp"
@@ -690,6 +691,48 @@ TEST(Candidates, SelfWeightTakesGravityInTheModelsUnits) {
     }
   }
   ASSERT_EQ(ratio.size(), 2u);
+  EXPECT_LT((ratio[0] - ratio[1]).cwiseAbs().maxCoeff(), 1e-9)
+      << ratio[0].transpose() << " vs " << ratio[1].transpose();
+}
+
+// Gravity's direction from the supports: a 3D frame drawn with y up (the z-up frame turned by -90 degrees about x)
+// stands on its lowest y, and its self_weight candidate at load factor 1 moves the eigenvalues by the same ratios as
+// the z-up frame's (1e-9 relative: the models differ by a rotation, rounding only; square sections, so the members'
+// default local axes do not matter). Before, gravity was -z in every space model: the y-up frame's own weight
+// pulled it sideways. A beam (one axis of extent) keeps the convention, -y in the plane.
+TEST(Candidates, GravityPointsFromTheSupportsLevel) {
+  Frame3DSpec spec = test::SteelFrame3D(1, 1, 2);
+  spec.column.Iy = spec.column.Iz;
+  spec.beam.Iy = spec.beam.Iz;
+  const Model zup = make_frame3d(spec);
+  Model yup;
+  for (const Material& x : zup.materials()) yup.add_material(x);
+  for (const Section& x : zup.sections()) yup.add_section(x);
+  for (const Node& n : zup.nodes()) yup.add_node(n.id, Eigen::Vector3d(n.x.x(), n.x.z(), -n.x.y()));
+  for (const Element& e : zup.elements()) yup.add_element(e);
+  for (const Node& n : zup.nodes())
+    if (n.x.z() == 0) yup.restrain(n.id, kAllDofs);
+  yup.finalize();
+  bool unconventional = true;
+  EXPECT_EQ(internal::default_gravity(zup, &unconventional), Eigen::Vector3d(0, 0, -1));
+  EXPECT_FALSE(unconventional);
+  EXPECT_EQ(internal::default_gravity(yup, &unconventional), Eigen::Vector3d(0, -1, 0));
+  EXPECT_TRUE(unconventional);
+  BeamSpec b = square_steel_beam(2.0);
+  b.support = BeamSupport::Cantilever;
+  EXPECT_EQ(internal::default_gravity(make_beam(b), &unconventional), Eigen::Vector3d(0, -1, 0));
+  EXPECT_FALSE(unconventional);
+
+  std::vector<Eigen::VectorXd> ratio;
+  for (const Model* m : {&zup, static_cast<const Model*>(&yup)}) {
+    for (const auto& c : candidate_library(*m, exact_modes(*m, *m, 4), DiscoveryOptions{})) {
+      if (c->kind() != "self_weight") continue;
+      const Eigen::VectorXd nominal = eigen_with(*m, *c, Eigen::VectorXd::Zero(1), 4);
+      ratio.push_back(eigen_with(*m, *c, Eigen::VectorXd::Ones(1), 4).cwiseQuotient(nominal));
+    }
+  }
+  ASSERT_EQ(ratio.size(), 2u);
+  EXPECT_LT(ratio[0].maxCoeff(), 1 - 1e-6) << "the own weight softens the sway modes";
   EXPECT_LT((ratio[0] - ratio[1]).cwiseAbs().maxCoeff(), 1e-9)
       << ratio[0].transpose() << " vs " << ratio[1].transpose();
 }

@@ -162,14 +162,50 @@ CandidateContext make_context(const Model& model, const ModalData& measured, con
         }
     }
   }
-  if (gravity.norm() > 0) {
-    c.gravity = gravity.normalized();
-  } else {
-    bool space = false;
-    for (const Element& el : model.elements()) space = space || element_kind(el.type).spatial();
-    c.gravity = space ? Eigen::Vector3d(0, 0, -1) : Eigen::Vector3d(0, -1, 0);
-  }
+  c.gravity = gravity.norm() > 0 ? Eigen::Vector3d(gravity.normalized()) : default_gravity(model);
   return c;
+}
+
+Eigen::Vector3d default_gravity(const Model& model, bool* unconventional) {
+  bool space = false;
+  for (const Element& el : model.elements()) space = space || element_kind(el.type).spatial();
+  const Eigen::Vector3d convention = space ? Eigen::Vector3d(0, 0, -1) : Eigen::Vector3d(0, -1, 0);
+  if (unconventional) *unconventional = false;
+  const int axes = space ? 3 : 2;
+  // The extent of the nodes elements use, and the coordinates of the supported ones (a translation restrained).
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = Eigen::Vector3d::Constant(-INFINITY);
+  Eigen::Vector3d slo = lo, shi = hi;
+  const DofMask translations = dof_bit(Dof::UX) | dof_bit(Dof::UY) | dof_bit(Dof::UZ);
+  const int nn = static_cast<int>(model.nodes().size());
+  for (int n = 0; n < nn; ++n) {
+    if (!model.dof_map().active(n)) continue;
+    const Eigen::Vector3d& x = model.nodes()[n].x;
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+    if (model.dof_map().restrained(n) & model.dof_map().active(n) & translations) {
+      slo = slo.cwiseMin(x);
+      shi = shi.cwiseMax(x);
+    }
+  }
+  // Down is the axis along which every support lies at the structure's lowest level (1 % of its extent there),
+  // when exactly one axis is so and the structure extends along at least two: a frame with y up, as some codes
+  // draw it, stands on its lowest y. A line of members (a beam, a mast) or supports at several levels say nothing:
+  // -y in the plane, -z in space.
+  int extended = 0, down = -1, candidates = 0;
+  const bool supported = shi.allFinite();
+  for (int a = 0; a < axes && supported; ++a) {
+    const double ext = hi[a] - lo[a];
+    if (!(ext > 0)) continue;
+    ++extended;
+    if (shi[a] - lo[a] <= 0.01 * ext) {
+      down = a;
+      ++candidates;
+    }
+  }
+  if (extended < 2 || candidates != 1) return convention;
+  const Eigen::Vector3d g = -Eigen::Vector3d::Unit(down);
+  if (unconventional) *unconventional = g != convention;
+  return g;
 }
 
 std::vector<std::unique_ptr<Candidate>> place_candidates(const CandidateContext& c, const std::vector<CandidateKind>& registry,

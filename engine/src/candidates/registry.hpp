@@ -12,13 +12,19 @@ namespace dynid::internal {
 
 /// The context of a discovery: scales, members, sensors, suspension points and gravity of `model`.
 /// `sensor_nodes`, `suspension_nodes`: user ids (empty = the measured nodes; the two nodes farthest apart);
-/// `gravity`: a direction (zero = -y for plane models, -z for space models); `modes`: the model's lowest modes
+/// `gravity`: a direction (zero = default_gravity); `modes`: the model's lowest modes
 /// (lowest_modes(), solved once by the caller); `band_modes`: those of its elastic modes (0-based, rigid-body modes
 /// not counted) paired with the data (empty: the first as many as `measured` holds). Throws InputError for unknown
 /// nodes.
 CandidateContext make_context(const Model& model, const ModalData& measured, const std::vector<int>& sensor_nodes,
                               const std::vector<int>& suspension_nodes, const Eigen::Vector3d& gravity,
                               const ModalResult& modes, const std::vector<int>& band_modes);
+
+/// Gravity's direction when the user gives none: minus the one axis along which every support (a restrained
+/// translation) lies at the structure's lowest coordinate, when exactly one axis is so and the structure extends
+/// along at least two (a frame drawn with y up stands on its lowest y); else -y for plane models, -z for space
+/// ones. `unconventional` (optional): the supports gave a direction other than that convention.
+Eigen::Vector3d default_gravity(const Model& model, bool* unconventional = nullptr);
 
 /// Every candidate of the kinds named in `kinds` (empty = all) among `registry`, placed on the model. Throws
 /// InputError naming a kind that is not in the registry, with the known ones.

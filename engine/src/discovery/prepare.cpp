@@ -212,8 +212,17 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
   std::vector<CandidateKind> registry = builtin_candidate_kinds();
   registry.insert(registry.end(), o.extra_kinds.begin(), o.extra_kinds.end());
   p.library = place_candidates(p.context, registry, o.kinds);
-  if (!(o.gravity_acceleration > 0) &&
-      std::any_of(p.library.begin(), p.library.end(), [](const auto& c) { return c->kind() == "self_weight"; })) {
+  const bool self_weight =
+      std::any_of(p.library.begin(), p.library.end(), [](const auto& c) { return c->kind() == "self_weight"; });
+  bool unconventional = false;
+  const Eigen::Vector3d down = default_gravity(model, &unconventional);
+  if (self_weight && !(o.gravity.norm() > 0) && unconventional) {
+    const std::string axis = down.x() != 0 ? "x" : down.y() != 0 ? "y" : "z";
+    S->warnings.push_back("gravity taken along -" + axis +
+                          " for self_weight: every support lies at the structure's lowest " + axis +
+                          " (discover: gravity says otherwise)");
+  }
+  if (!(o.gravity_acceleration > 0) && self_weight) {
     if (!unit.known)
       S->warnings.push_back(
           "the materials do not say the model's length unit (slowest sqrt(E / rho) " + fmt_value(unit.wave_speed, 3) +
