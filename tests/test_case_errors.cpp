@@ -93,6 +93,19 @@ TEST(CaseErrors, GravityAndUnitsOfDiscovery) {
   EXPECT_TRUE(parse_case(mm_model + d + "  units: si\n", "case.yaml").discover->options.si_units);  // as stated
 }
 
+// Stated noise levels are fractions: a percentage (1 for 1 %) is refused with the line and the right form, never read
+// as 100 %, which would make every mismatch noise.
+TEST(CaseErrors, NoiseLevelsAreFractions) {
+  const std::string d = std::string(kGood) + "discover:\n  measured: modes.uff\n";
+  std::string e = Error(d + "  frequency_noise: 1\n");
+  EXPECT_HAS(e, "case.yaml:16:");
+  EXPECT_HAS(e, "0.01 for 1 %");
+  e = Error(d + "  shape_noise: 5\n");
+  EXPECT_HAS(e, "case.yaml:16:");
+  EXPECT_HAS(e, "0.05 for 5 %");
+  EXPECT_EQ(Error(d + "  frequency_noise: 0.01\n  shape_noise: 0.05\n"), "(no error)");
+}
+
 TEST(CaseErrors, UnknownElementType) {
   const std::string e = Error(Replace(kGood, "element: frame2d", "element: frame4d"));
   EXPECT_HAS(e, "case.yaml:3:");

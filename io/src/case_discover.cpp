@@ -145,8 +145,21 @@ DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model
   if (n["modes"]) d.modes = ctx.integer(n["modes"], "discover modes");
   if (n["min_mpc"]) d.min_mpc = ctx.number(n["min_mpc"], "discover min_mpc");
   DiscoveryOptions& o = d.options;
-  if (n["frequency_noise"]) o.frequency_noise = ctx.number(n["frequency_noise"], "discover frequency_noise");
-  if (n["shape_noise"]) o.shape_noise = ctx.number(n["shape_noise"], "discover shape_noise");
+  // Both are fractions. A frequency known to 20 % or a shape entry to 100 % of the mode's largest says nothing
+  // discovery could use; such a value is most likely a percentage (1 meant as 1 %).
+  if (n["frequency_noise"]) {
+    o.frequency_noise = ctx.number(n["frequency_noise"], "discover frequency_noise");
+    if (!(o.frequency_noise > 0 && o.frequency_noise < 0.2))
+      ctx.fail(n["frequency_noise"],
+               "discover frequency_noise: the frequencies' relative std, a fraction in (0, 0.2): 0.01 for 1 %");
+  }
+  if (n["shape_noise"]) {
+    o.shape_noise = ctx.number(n["shape_noise"], "discover shape_noise");
+    if (!(o.shape_noise > 0 && o.shape_noise < 1))
+      ctx.fail(n["shape_noise"],
+               "discover shape_noise: the shape entries' std relative to each mode's largest entry, a fraction in (0, "
+               "1): 0.05 for 5 %");
+  }
   if (n["kinds"]) {
     ctx.require_sequence(n["kinds"], "discover kinds");
     for (const auto& k : n["kinds"]) {
