@@ -695,6 +695,27 @@ TEST(Candidates, SelfWeightTakesGravityInTheModelsUnits) {
       << ratio[0].transpose() << " vs " << ratio[1].transpose();
 }
 
+// A tension no member could carry is no preload: the axial_preload candidate of all the portal's members is plausible
+// up to a force stretching the weakest member (the beams, E A = 2.1e11 x 3.91e-3 N) by 1 % and not beyond (steel
+// yields near 0.2 %, prestressing tendons near 0.9 %). Found on test3-072 (null data): "an axial tension of 6.6e10 N
+// +- 430 %" in a frame's links, 10^4 times what they could carry.
+TEST(Candidates, PreloadBeyondWhatMembersCarryIsImplausible) {
+  const Model m = make_frame2d(portal());
+  const double ea = 2.1e11 * 3.91e-3;
+  int found = 0;
+  for (const auto& c : candidate_library(m, exact_modes(m, m, 4), DiscoveryOptions{})) {
+    if (c->kind() != "axial_preload" || c->site().elements.size() != static_cast<std::size_t>(m.num_elements()))
+      continue;
+    ++found;
+    const double per_unit = c->physical(Eigen::VectorXd::Ones(1), Eigen::VectorXd::Zero(1)).at(0).value;  // N
+    EXPECT_TRUE(c->plausible(Eigen::VectorXd::Constant(1, 0.0099 * ea / per_unit)));
+    EXPECT_FALSE(c->plausible(Eigen::VectorXd::Constant(1, 0.0101 * ea / per_unit)));
+    EXPECT_TRUE(
+        c->plausible(Eigen::VectorXd::Constant(1, c->parameters().at(0).lower)));  // compression: buckling bounds it
+  }
+  EXPECT_EQ(found, 1);
+}
+
 // Gravity's direction from the supports: a 3D frame drawn with y up (the z-up frame turned by -90 degrees about x)
 // stands on its lowest y, and its self_weight candidate at load factor 1 moves the eigenvalues by the same ratios as
 // the z-up frame's (1e-9 relative: the models differ by a rotation, rounding only; square sections, so the members'

@@ -27,6 +27,9 @@ class OnElements : public Candidate {
   Site site_;
 };
 
+// The largest axial strain a preload may stretch a member by (AxialPreload::plausible).
+constexpr double kMaxPreloadStrain = 0.01;
+
 // P int N'^T N' (the consistent geometric stiffness) on every element of the group. Unit: the force that shifts
 // the band's eigenvalues by 100 % in all, to first order (1 / sum_r phi_r^T G phi_r / omega_r^2, G the group's
 // geometric stiffness per unit force): a tie rod the data's modes hardly feel needs a large force, a strip a
@@ -67,8 +70,17 @@ class AxialPreload : public OnElements {
       }
     }
     lower_ = -0.9 * buckling / pref_;
+    for (int e : els_) {
+      const Element& el = m.elements()[e];
+      if (el.material < 0 || el.section < 0) continue;
+      const double EA = m.materials()[el.material].E * el.factors.E * m.sections()[el.section].A * el.factors.A;
+      if (EA > 0) ea_ = std::min(ea_, EA);
+    }
   }
   std::string kind() const override { return "axial_preload"; }
+  /// A tension that stretches the group's weakest member by more than kMaxPreloadStrain is no preload a
+  /// structure carries (steel yields near 0.2 %, prestressing tendons near 0.9 %); compression stops at buckling.
+  bool plausible(const Eigen::VectorXd& th) const override { return pref_ * th[0] <= kMaxPreloadStrain * ea_; }
   Nature nature() const override { return Nature::kStiffness; }
   std::string description() const override { return "axial preload (geometric stiffness) in " + group_words(group_); }
   std::vector<CandidateParameter> parameters() const override {
@@ -93,6 +105,7 @@ class AxialPreload : public OnElements {
 
  private:
   double pref_ = 1, lower_ = -0.9;
+  double ea_ = INFINITY;  // the group's smallest E A
 };
 
 // Translational mass rho A int N^T N added in proportion to the members' own: a fraction of the group's mass.
