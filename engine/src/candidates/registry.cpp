@@ -172,9 +172,9 @@ Eigen::Vector3d default_gravity(const Model& model, bool* unconventional) {
   const Eigen::Vector3d convention = space ? Eigen::Vector3d(0, 0, -1) : Eigen::Vector3d(0, -1, 0);
   if (unconventional) *unconventional = false;
   const int axes = space ? 3 : 2;
-  // The extent of the nodes elements use, and the coordinates of the supported ones (a translation restrained).
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = Eigen::Vector3d::Constant(-INFINITY);
-  Eigen::Vector3d slo = lo, shi = hi;
+  // The extent of the nodes elements use, and the highest coordinates of the supported ones (a translation
+  // restrained).
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = Eigen::Vector3d::Constant(-INFINITY), shi = hi;
   const DofMask translations = dof_bit(Dof::UX) | dof_bit(Dof::UY) | dof_bit(Dof::UZ);
   const int nn = static_cast<int>(model.nodes().size());
   for (int n = 0; n < nn; ++n) {
@@ -182,10 +182,7 @@ Eigen::Vector3d default_gravity(const Model& model, bool* unconventional) {
     const Eigen::Vector3d& x = model.nodes()[n].x;
     lo = lo.cwiseMin(x);
     hi = hi.cwiseMax(x);
-    if (model.dof_map().restrained(n) & model.dof_map().active(n) & translations) {
-      slo = slo.cwiseMin(x);
-      shi = shi.cwiseMax(x);
-    }
+    if (model.dof_map().restrained(n) & model.dof_map().active(n) & translations) shi = shi.cwiseMax(x);
   }
   // Down is the axis along which every support lies at the structure's lowest level (1 % of its extent there),
   // when exactly one axis is so and the structure extends along at least two: a frame with y up, as some codes
