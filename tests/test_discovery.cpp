@@ -720,7 +720,7 @@ TEST(Candidates, PreloadBeyondWhatMembersCarryIsImplausible) {
 // stands on its lowest y, and its self_weight candidate at load factor 1 moves the eigenvalues by the same ratios as
 // the z-up frame's (1e-9 relative: the models differ by a rotation, rounding only; square sections, so the members'
 // default local axes do not matter). Before, gravity was -z in every space model: the y-up frame's own weight
-// pulled it sideways. A beam (one axis of extent) keeps the convention, -y in the plane.
+// pulled it sideways. Plane models keep -y: the portal held only at a wall (its nodes at x = 0) as much as a beam.
 TEST(Candidates, GravityPointsFromTheSupportsLevel) {
   Frame3DSpec spec = test::SteelFrame3D(1, 1, 2);
   spec.column.Iy = spec.column.Iz;
@@ -742,6 +742,12 @@ TEST(Candidates, GravityPointsFromTheSupportsLevel) {
   BeamSpec b = square_steel_beam(2.0);
   b.support = BeamSupport::Cantilever;
   EXPECT_EQ(internal::default_gravity(make_beam(b), &unconventional), Eigen::Vector3d(0, -1, 0));
+  EXPECT_FALSE(unconventional);
+  Model wall = test::UnsupportedCopy(make_frame2d(portal()));
+  for (const Node& n : wall.nodes())
+    if (n.x.x() == 0) wall.restrain(n.id, kAllDofs);
+  wall.finalize();
+  EXPECT_EQ(internal::default_gravity(wall, &unconventional), Eigen::Vector3d(0, -1, 0));
   EXPECT_FALSE(unconventional);
 
   std::vector<Eigen::VectorXd> ratio;

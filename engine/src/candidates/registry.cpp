@@ -169,9 +169,8 @@ CandidateContext make_context(const Model& model, const ModalData& measured, con
 Eigen::Vector3d default_gravity(const Model& model, bool* unconventional) {
   bool space = false;
   for (const Element& el : model.elements()) space = space || element_kind(el.type).spatial();
-  const Eigen::Vector3d convention = space ? Eigen::Vector3d(0, 0, -1) : Eigen::Vector3d(0, -1, 0);
   if (unconventional) *unconventional = false;
-  const int axes = space ? 3 : 2;
+  if (!space) return Eigen::Vector3d(0, -1, 0);  // plane models: y up in every code we know of
   // The extent of the nodes elements use, and the highest coordinates of the supported ones (a translation
   // restrained).
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = Eigen::Vector3d::Constant(-INFINITY), shi = hi;
@@ -184,25 +183,15 @@ Eigen::Vector3d default_gravity(const Model& model, bool* unconventional) {
     hi = hi.cwiseMax(x);
     if (model.dof_map().restrained(n) & model.dof_map().active(n) & translations) shi = shi.cwiseMax(x);
   }
-  // Down is the axis along which every support lies at the structure's lowest level (1 % of its extent there),
-  // when exactly one axis is so and the structure extends along at least two: a frame with y up, as some codes
-  // draw it, stands on its lowest y. A line of members (a beam, a mast) or supports at several levels say nothing:
-  // -y in the plane, -z in space.
-  int extended = 0, down = -1, candidates = 0;
-  const bool supported = shi.allFinite();
-  for (int a = 0; a < axes && supported; ++a) {
-    const double ext = hi[a] - lo[a];
-    if (!(ext > 0)) continue;
-    ++extended;
-    if (shi[a] - lo[a] <= 0.01 * ext) {
-      down = a;
-      ++candidates;
-    }
-  }
-  if (extended < 2 || candidates != 1) return convention;
-  const Eigen::Vector3d g = -Eigen::Vector3d::Unit(down);
-  if (unconventional) *unconventional = g != convention;
-  return g;
+  // Space models are drawn with z up or with y up. A structure that extends along two axes or more and has every
+  // support at its lowest z (1 % of its extent there) stands on z; otherwise, every support at its lowest y, it
+  // stands on y; otherwise (supports at several levels, a line of members) z up.
+  const Eigen::Vector3d ext = hi - lo;
+  const int extended = (ext.array() > 0).count();
+  auto at_bottom = [&](int a) { return ext[a] > 0 && shi[a] - lo[a] <= 0.01 * ext[a]; };
+  if (!shi.allFinite() || extended < 2 || at_bottom(2) || !at_bottom(1)) return Eigen::Vector3d(0, 0, -1);
+  if (unconventional) *unconventional = true;
+  return Eigen::Vector3d(0, -1, 0);
 }
 
 std::vector<std::unique_ptr<Candidate>> place_candidates(const CandidateContext& c, const std::vector<CandidateKind>& registry,

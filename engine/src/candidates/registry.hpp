@@ -20,10 +20,9 @@ CandidateContext make_context(const Model& model, const ModalData& measured, con
                               const std::vector<int>& suspension_nodes, const Eigen::Vector3d& gravity,
                               const ModalResult& modes, const std::vector<int>& band_modes);
 
-/// Gravity's direction when the user gives none: minus the one axis along which every support (a restrained
-/// translation) lies at the structure's lowest coordinate, when exactly one axis is so and the structure extends
-/// along at least two (a frame drawn with y up stands on its lowest y); else -y for plane models, -z for space
-/// ones. `unconventional` (optional): the supports gave a direction other than that convention.
+/// Gravity's direction when the user gives none: -y for plane models; for space models -z, or -y when the model
+/// stands on its lowest y (every support there, not every one at the lowest z, the structure extending along two
+/// axes or more: a frame drawn with y up). `unconventional` (optional): the -y of a space model.
 Eigen::Vector3d default_gravity(const Model& model, bool* unconventional = nullptr);
 
 /// Every candidate of the kinds named in `kinds` (empty = all) among `registry`, placed on the model. Throws

@@ -82,9 +82,8 @@ struct DiscoveryOptions {
   std::vector<CandidateKind> extra_kinds;  ///< a host code's own kinds, considered with dynid's
   std::vector<int> sensor_nodes;   ///< nodes carrying sensors (sensor mass loading); empty = the measured nodes
   std::vector<int> suspension_nodes;  ///< free-free tests: suspension points (empty = the two farthest nodes)
-  /// Gravity's direction (self_weight). Zero: minus the one axis along which every support lies at the
-  /// structure's lowest coordinate (a frame drawn with y up stands on its lowest y), when the structure extends
-  /// along two axes or more and exactly one axis is so; else -y for plane models, -z for space ones.
+  /// Gravity's direction (self_weight). Zero: -y for plane models; -z for space ones, or -y when the structure
+  /// stands on its lowest y (every support there and not every one at its lowest z: a frame drawn with y up).
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
   /// The acceleration of gravity in the model's units (self_weight's loads); 0 = 9.81 m/s^2 in the length unit
   /// the model's materials imply (mesh/units.hpp: metres or millimetres; metres when they do not say, with a
