@@ -84,6 +84,7 @@ Member member(const Model& model, int e) {
   const auto& n = model.element_nodes(e);
   m.L = (model.nodes()[n[1]].x - model.nodes()[n[0]].x).norm();
   m.EI = mat.E * el.factors.E * sec.Iz * el.factors.I;
+  m.EA = mat.E * el.factors.E * sec.A * el.factors.A;
   m.GA = mat.shear_modulus() * el.factors.E * sec.A * el.factors.A;
   m.rhoA = mat.rho * el.factors.rho * sec.A * el.factors.A;
   m.rhoI = mat.rho * el.factors.rho * sec.Iz * el.factors.I;

@@ -23,7 +23,7 @@ struct Member {
   std::vector<int> dofs;
   std::vector<std::pair<int, Dof>> types;
   Eigen::MatrixXd K, Ks, M, Kb, Mt;
-  double L = 0, EI = 0, GA = 0, rhoA = 0, rhoI = 0;
+  double L = 0, EI = 0, EA = 0, GA = 0, rhoA = 0, rhoI = 0;
 };
 Member member(const Model& model, int e);
 

@@ -45,7 +45,9 @@ class AxialPreload : public OnElements {
     Eigen::VectorXd sens = Eigen::VectorXd::Zero(c.band_modes.cols());
     std::vector<int> dofs;
     for (int e : els_) {
-      EI += member(m, e).EI / static_cast<double>(els_.size());
+      const Member mb = member(m, e);
+      EI += mb.EI / static_cast<double>(els_.size());
+      if (mb.EA > 0) ea_ = std::min(ea_, mb.EA);
       for (int k = 0; k < 2; ++k) {
         a = a.cwiseMin(m.nodes()[m.element_nodes(e)[k]].x);
         b = b.cwiseMax(m.nodes()[m.element_nodes(e)[k]].x);
@@ -70,12 +72,6 @@ class AxialPreload : public OnElements {
       }
     }
     lower_ = -0.9 * buckling / pref_;
-    for (int e : els_) {
-      const Element& el = m.elements()[e];
-      if (el.material < 0 || el.section < 0) continue;
-      const double EA = m.materials()[el.material].E * el.factors.E * m.sections()[el.section].A * el.factors.A;
-      if (EA > 0) ea_ = std::min(ea_, EA);
-    }
   }
   std::string kind() const override { return "axial_preload"; }
   /// A tension that stretches the group's weakest member by more than kMaxPreloadStrain is no preload a

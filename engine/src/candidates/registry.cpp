@@ -162,7 +162,7 @@ CandidateContext make_context(const Model& model, const ModalData& measured, con
         }
     }
   }
-  c.gravity = gravity.norm() > 0 ? Eigen::Vector3d(gravity.normalized()) : default_gravity(model);
+  c.gravity = gravity.normalized();
   return c;
 }
 

@@ -12,10 +12,10 @@ namespace dynid::internal {
 
 /// The context of a discovery: scales, members, sensors, suspension points and gravity of `model`.
 /// `sensor_nodes`, `suspension_nodes`: user ids (empty = the measured nodes; the two nodes farthest apart);
-/// `gravity`: a direction (zero = default_gravity); `modes`: the model's lowest modes
-/// (lowest_modes(), solved once by the caller); `band_modes`: those of its elastic modes (0-based, rigid-body modes
-/// not counted) paired with the data (empty: the first as many as `measured` holds). Throws InputError for unknown
-/// nodes.
+/// `gravity`: a direction (non-zero; the caller's default_gravity when the user gives none); `modes`: the model's
+/// lowest modes (lowest_modes(), solved once by the caller); `band_modes`: those of its elastic modes (0-based,
+/// rigid-body modes not counted) paired with the data (empty: the first as many as `measured` holds). Throws InputError
+/// for unknown nodes.
 CandidateContext make_context(const Model& model, const ModalData& measured, const std::vector<int>& sensor_nodes,
                               const std::vector<int>& suspension_nodes, const Eigen::Vector3d& gravity,
                               const ModalResult& modes, const std::vector<int>& band_modes);

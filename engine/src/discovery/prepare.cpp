@@ -203,7 +203,9 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
     p.unpartnered_edge.setConstant(gain(wf) + gain(ws) * static_cast<double>(measured.dofs.size()));
   }
 
-  p.context = make_context(model, p.data.num_modes() ? p.data : measured, o.sensor_nodes, o.suspension_nodes, o.gravity,
+  bool unconventional = false;  // gravity along -y in a space model (default_gravity)
+  const Eigen::Vector3d down = o.gravity.norm() > 0 ? o.gravity : default_gravity(model, &unconventional);
+  p.context = make_context(model, p.data.num_modes() ? p.data : measured, o.sensor_nodes, o.suspension_nodes, down,
                            modes, partner);
   p.context.measured = &p.data;
   const LengthUnit unit = length_unit(model);
@@ -214,14 +216,10 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
   p.library = place_candidates(p.context, registry, o.kinds);
   const bool self_weight =
       std::any_of(p.library.begin(), p.library.end(), [](const auto& c) { return c->kind() == "self_weight"; });
-  bool unconventional = false;
-  const Eigen::Vector3d down = default_gravity(model, &unconventional);
-  if (self_weight && !(o.gravity.norm() > 0) && unconventional) {
-    const std::string axis = down.x() != 0 ? "x" : down.y() != 0 ? "y" : "z";
-    S->warnings.push_back("gravity taken along -" + axis +
-                          " for self_weight: every support lies at the structure's lowest " + axis +
-                          " (discover: gravity says otherwise)");
-  }
+  if (self_weight && unconventional)
+    S->warnings.push_back(
+        "gravity taken along -y for self_weight: every support lies at the structure's lowest y "
+        "(discover: gravity says otherwise)");
   if (!(o.gravity_acceleration > 0) && self_weight) {
     if (!unit.known)
       S->warnings.push_back(
