@@ -22,12 +22,7 @@ struct DiscoverArgs {
   bool exact = false;  // diagnosis: the truth model's exact modes instead of the identified ones
 };
 
-void print_summary(const Case& c, const DiscoveryData& d, const DiscoverySummary& s) {
-  fmt::print("dynid discover: {} — {} measured modes at {} DOFs ({})\n", c.name, d.measured.num_modes(), d.measured.dofs.size(), d.source);
-  for (const std::string& n : d.notes) fmt::print("  note: {}\n", n);
-  for (const std::string& n : set_aside_words(s)) fmt::print("  note: {}\n", n);
-  for (const std::string& w : s.warnings) fmt::print("  warning: {}\n", w);
-  fmt::print("  1. where:  {}\n", localization_words(s));
+void print_candidates(const Case& c, const DiscoverySummary& s) {
   fmt::print("  2-3. candidates (ln Bayes factor over the model as given; > {:.0f} is decisive):\n", c.discover->options.decisive);
   fmt::print("       {:>4}  {:<22} {:<28} {:>9} {:>9} {:>8}\n", "rank", "kind", "where", "evidence", "max df %", "MAC");
   const int show = std::min<int>(12, static_cast<int>(s.candidates.size()));
@@ -41,6 +36,20 @@ void print_summary(const Case& c, const DiscoveryData& d, const DiscoverySummary
   const ScoredHypothesis& r = s.recalibration;
   fmt::print("       {:>4}  {:<22} {:<28} {:>9.1f} {:>9.3f} {:>8.5f}\n", "-", "global_recalibration", "global (E, rho)", r.log_evidence,
              r.max_freq_error_pct, r.mean_mac);
+}
+
+void print_summary(const Case& c, const DiscoveryData& d, const DiscoverySummary& s) {
+  fmt::print("dynid discover: {} — {} measured modes at {} DOFs ({})\n", c.name, d.measured.num_modes(),
+             d.measured.dofs.size(), d.source);
+  for (const std::string& n : d.notes) fmt::print("  note: {}\n", n);
+  for (const std::string& n : set_aside_words(s)) fmt::print("  note: {}\n", n);
+  for (const std::string& w : s.warnings) fmt::print("  warning: {}\n", w);
+  fmt::print("  1. where:  {}\n", localization_words(s));
+  if (s.candidates.empty() && !s.recalibration.fitted) {
+    fmt::print("  2-3. candidates: none fitted\n");
+  } else {
+    print_candidates(c, s);
+  }
   if (s.steps.size() > 1) {
     fmt::print("  selection:\n");
     for (const SelectionStep& st : s.steps)

@@ -290,6 +290,29 @@ TEST(Discovery, ExactDataOfTheModelIsConsistent) {
   EXPECT_LT(s.before.max_freq_error_pct, 1e-6);
 }
 
+// One paired mode is a test, not an explanation: the model's own first mode is consistent; a base on a spring
+// soft enough to lower that mode by several percent (far beyond the 1 % stated noise) is inconclusive, never a
+// named physics (any one-parameter candidate matches one frequency). Both say why in a warning.
+TEST(Discovery, OneModeTestsButNamesNothing) {
+  const Model analysis = make_frame2d(portal());
+  DiscoveryOptions o;
+  o.frequency_noise = 0.01;
+  o.shape_noise = 0.03;
+  const DiscoverySummary same = discover(analysis, exact_modes(analysis, analysis, 1), o);
+  EXPECT_EQ(same.verdict, Verdict::kConsistent) << said(same);
+  const Model soft = portal_on_base_spring(2e5);
+  const ModalData meas = exact_modes(soft, analysis, 1);
+  ASSERT_LT(meas.frequencies_hz[0], 0.95 * same.before.measured_hz[0]);  // the test means something
+  const DiscoverySummary d = discover(analysis, meas, o);
+  EXPECT_EQ(d.verdict, Verdict::kInconclusive) << said(d);
+  EXPECT_TRUE(d.findings.empty());
+  for (const DiscoverySummary* x : {&same, &d}) {
+    bool warned = false;
+    for (const std::string& w : x->warnings) warned = warned || w.find("only one measured mode") != std::string::npos;
+    EXPECT_TRUE(warned);
+  }
+}
+
 // Noise taken from the data is floored (split-data estimates see no identification bias); stated noise is kept
 // as stated. Exact values: the floors are the DiscoveryOptions defaults, compared exactly.
 TEST(Discovery, DataNoiseIsFlooredStatedNoiseIsKept) {

@@ -230,14 +230,13 @@ ModalData keep_modes(ModalData m, const DiscoverSpec& d, const std::string& sour
     }
     keep.push_back(k);
   }
-  if (m.num_modes() >= 2 && keep.size() < 2)
-    throw InputError(
-        source + ": discover: " + (keep.empty() ? std::string("none") : "only 1") + " of the " +
-        std::to_string(m.num_modes()) + " modes is a normal mode; the others' shapes are complex (MPC below " +
-        "discover: min_mpc = " + format_number(d.min_mpc, 3) + "): " + left_out +
-        ". Discovery needs at least 2. Close modes or too few sensors make identified "
-        "shapes complex: more sensors or another band (discover: identify: band_hz) would help, or a lower "
-        "min_mpc if these are real modes.");
+  if (m.num_modes() >= 1 && keep.empty())
+    throw InputError(source + ": discover: none of the " + std::to_string(m.num_modes()) +
+                     " modes is a normal mode; their shapes are complex (MPC below discover: min_mpc = " +
+                     format_number(d.min_mpc, 3) + "): " + left_out +
+                     ". Discovery needs at least 1. Close modes or too few sensors make identified "
+                     "shapes complex: more sensors or another band (discover: identify: band_hz) would help, or a "
+                     "lower min_mpc if these are real modes.");
   if (d.modes > 0 && static_cast<int>(keep.size()) > d.modes) keep.resize(static_cast<std::size_t>(d.modes));
   return modes_subset(m, keep);
 }
@@ -277,10 +276,10 @@ void identify_recordings_for(const Case& c, std::vector<Recording> recs, Discove
                            format_number(m.expected_hz, 5) + " Hz (MAC >= " + format_number(io.expected_mac, 2) + ")");
   out->measured = out->identification.modal_data("identified from " + out->source);
   const Eigen::Index found = out->measured.num_modes();
-  if (found < 2)
-    throw InputError(out->source + ": discover: identification (" + out->identification.method + ") found " +
-                     std::to_string(found) + " mode" + (found == 1 ? "" : "s") + " " + band_words +
-                     "; discovery needs at least 2. Longer records, more or "
+  if (found < 1)
+    throw InputError(out->source + ": discover: identification (" + out->identification.method + ") found no mode " +
+                     band_words +
+                     "; discovery needs at least 1. Longer records, more or "
                      "better-placed sensors, or another band (discover: identify: band_hz: [lo, hi]) would help; "
                      "`dynid identify` on the same files lists the rejected poles and why.");
 }

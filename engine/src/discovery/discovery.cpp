@@ -346,12 +346,12 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   };
   Problem p;
   prepare(model, measured, options, std::move(extra), &p, &S);
-  if (p.modes < 2) {
+  if (p.modes < 1) {
     S.verdict = Verdict::kInconclusive;
     S.reason = VerdictReason::kNothingDecisive;
-    S.warnings.push_back("fewer than two measured modes have a plausible partner in the model (MAC >= " +
-                         std::to_string(options.min_mac) + " within a frequency ratio of " + std::to_string(options.max_frequency_ratio) +
-                         "): nothing can be compared");
+    S.warnings.push_back(
+        "no measured mode has a plausible partner in the model (MAC >= " + std::to_string(options.min_mac) +
+        " within a frequency ratio of " + std::to_string(options.max_frequency_ratio) + "): nothing can be compared");
     return finish();
   }
 
@@ -373,6 +373,20 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
   screening_nature(p, sc, &S.localization);
   const bool consistent = sc.chi2_frequency <= chi2_quantile(p.modes, 0.5 * options.consistency_level) &&
                           chi2_0 - sc.chi2_frequency <= chi2_quantile(std::max(1, p.n - p.modes), 0.5 * options.consistency_level);
+
+  if (p.modes == 1) {
+    // One mode is a test, not an explanation: its frequency and shape can show that the model misses something,
+    // but any one-parameter candidate matches one frequency, so which physics cannot be told apart.
+    S.warnings.push_back(
+        "only one measured mode pairs with the model: the consistency test rests on it alone, and "
+        "no missing physics can be named from one mode (more modes: more or better-placed sensors, "
+        "or a wider band)");
+    if (!consistent) {
+      S.verdict = Verdict::kInconclusive;
+      S.reason = VerdictReason::kNothingDecisive;
+    }
+    return finish();
+  }
 
   // ---- fit the shortlisted candidates and the recalibration ----
   const std::vector<int> list = shortlist(p, sc, S.localization);

@@ -123,7 +123,7 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
   std::string why;
   if (!o.IsValid(&why)) throw InputError("discover options: " + why);
   measured.validate("measured modal data");
-  if (measured.num_modes() < 2) throw InputError("discover: at least 2 measured modes are needed");
+  if (measured.num_modes() < 1) throw InputError("discover: no measured modes");
   measured_equations(model, measured.dofs);  // throws naming a DOF the model does not have
   Problem& p = *pp;
   p.model = &model;
