@@ -210,8 +210,8 @@ TEST(DetectPairing, ModeTheSensorsCannotSeeIsNoPartner) {
   const DetectSummary s = detect(c.model, d, DetectOptions{});
   bool unpaired = false;
   for (const std::string& w : s.warnings)
-    unpaired =
-        unpaired || w.find("mode 4 (") != std::string::npos && w.find("pairs with no model mode") != std::string::npos;
+    unpaired = unpaired ||
+               (w.find("mode 4 (") != std::string::npos && w.find("pairs with no model mode") != std::string::npos);
   EXPECT_TRUE(unpaired);
   EXPECT_EQ(s.used_modes, (std::vector<int>{0, 1, 2}));
 }
