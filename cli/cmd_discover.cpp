@@ -39,8 +39,8 @@ void print_candidates(const Case& c, const DiscoverySummary& s) {
 }
 
 void print_summary(const Case& c, const DiscoveryData& d, const DiscoverySummary& s) {
-  fmt::print("dynid discover: {} — {} measured modes at {} DOFs ({})\n", c.name, d.measured.num_modes(),
-             d.measured.dofs.size(), d.source);
+  fmt::print("dynid discover: {} — {} measured mode{} at {} DOFs ({})\n", c.name, d.measured.num_modes(),
+             d.measured.num_modes() == 1 ? "" : "s", d.measured.dofs.size(), d.source);
   for (const std::string& n : d.notes) fmt::print("  note: {}\n", n);
   for (const std::string& n : set_aside_words(s)) fmt::print("  note: {}\n", n);
   for (const std::string& w : s.warnings) fmt::print("  warning: {}\n", w);
