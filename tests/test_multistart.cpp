@@ -135,7 +135,9 @@ TEST(Multistart, SameResultForAnyThreadCountAndTheBestIsNoWorse) {
     EXPECT_EQ(one.minima[m].theta, two.minima[m].theta);
     EXPECT_EQ(one.minima[m].starts, two.minima[m].starts);
     counted += one.minima[m].starts.size();
-    if (m > 0) EXPECT_GE(one.minima[m].cost, one.minima[m - 1].cost);
+    if (m > 0) {
+      EXPECT_GE(one.minima[m].cost, one.minima[m - 1].cost);
+    }
   }
   EXPECT_EQ(counted + static_cast<std::size_t>(one.failed), one.start_points.size());
   const FitSummary single = fit_parameters(*s.pm, s.measured, u.initial, u.free, u.options);

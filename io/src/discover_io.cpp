@@ -261,7 +261,11 @@ std::vector<std::string> set_aside_words(const DiscoverySummary& s) {
     std::string w = "measured mode " + std::to_string(a.mode + 1) + " (" + format_number(a.frequency_hz, 4) + " Hz) ";
     if (a.reason == SetAside::Reason::kRigidBody) {
       w += "is a rigid-body motion on the test's suspension (MAC " + format_number(a.mac, 3) +
-           " with the model's rigid-body motions, below its first elastic mode): set aside; suspension_stiffness describes it";
+           " with the model's rigid-body motions, below its first elastic mode): set aside from the selection; "
+           "suspension_stiffness describes it";
+      if (a.paired_after)
+        w += ", and the findings' values are fitted with it: predicted at " + format_number(a.model_hz_after, 4) +
+             " Hz (MAC " + format_number(a.mac_after, 3) + ")";
     } else {
       w += "has no plausible partner in the model as given (best MAC " + format_number(a.mac, 3) + "): set aside, never forced onto another mode";
       if (a.paired_after)

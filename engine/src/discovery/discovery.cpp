@@ -149,6 +149,71 @@ void check_set_aside(const Problem& p, const ModalData& measured, const SetFit& 
   }
 }
 
+// A free-free test's rigid-body modes on its suspension are set aside from the selection (the model as given has
+// them at 0 Hz, so they would decide every free-free story). Once the suspension is a finding they are its most
+// direct measure: bounce and pitch rest on the springs alone, where the elastic modes feel the springs only
+// through the motion of the points they hold, which a suspension point a little in from the model's end node
+// changes. The findings' values are refitted with them (the evidence stays the selection's), and the set-aside
+// modes say what the findings predict. Nothing changes when the refit does not pair each of them.
+void refit_with_rigid_body_modes(const Problem& p, const ModalData& measured, const SetFit& f,
+                                 const std::vector<std::size_t>& order, DiscoverySummary* T) {
+  std::vector<int> rigid;
+  std::set<int> aside;
+  for (const SetAside& s : T->set_aside) {
+    aside.insert(s.mode);
+    if (s.reason == SetAside::Reason::kRigidBody) rigid.push_back(s.mode);
+  }
+  const bool suspension =
+      std::any_of(f.set.begin(), f.set.end(), [](const Candidate* c) { return c->kind() == "suspension_stiffness"; });
+  if (rigid.empty() || !suspension || !f.ok) return;
+  std::vector<int> keep;
+  for (int k = 0; k < measured.num_modes(); ++k)
+    if (!aside.count(k)) keep.push_back(k);
+  if (static_cast<int>(keep.size()) != p.modes) return;
+  const int used = p.modes;
+  keep.insert(keep.end(), rigid.begin(), rigid.end());  // the rigid-body modes last
+  const ModalData d = modes_subset(measured, keep);
+  FitOptions fo = p.fit;
+  auto extend = [&](Eigen::VectorXd* v, double typical) {
+    if (v->size() != used) return;
+    v->conservativeResize(d.num_modes());
+    v->tail(static_cast<Eigen::Index>(rigid.size())).setConstant(typical);
+  };
+  extend(&fo.frequency_noise_modes, p.noise.frequency);
+  extend(&fo.shape_noise_modes, p.noise.shape);
+  ParametricModel pm(*p.model);
+  const std::vector<int> first = install_candidates(&pm, f.set);
+  Eigen::VectorXd theta0 = pm.nominal();
+  for (std::size_t k = 0; k < f.set.size(); ++k) theta0.segment(first[k], f.theta[k].size()) = f.theta[k];
+  FitSummary s;
+  try {
+    s = fit_parameters(pm, d, theta0, {}, fo);
+  } catch (const NumericalError&) {
+    return;
+  }
+  if (!std::isfinite(s.final_cost) || s.final_forced.size() != static_cast<std::size_t>(d.num_modes())) return;
+  for (std::size_t j = 0; j < rigid.size(); ++j)
+    if (s.final_forced[static_cast<std::size_t>(used) + j] || !(s.final_hz[used + static_cast<Eigen::Index>(j)] > 0))
+      return;
+  SetFit r = f;
+  for (std::size_t k = 0; k < f.set.size(); ++k) r.theta[k] = s.theta.segment(first[k], f.theta[k].size());
+  r.information = s.information;
+  r.information_frequency = s.information_frequency;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const ScoredHypothesis h = scored(p, r, order[k]);
+    T->findings[k].values = h.values;
+    T->findings[k].finding = h.finding;
+  }
+  for (SetAside& a : T->set_aside) {
+    if (a.reason != SetAside::Reason::kRigidBody) continue;
+    const Eigen::Index j =
+        used + static_cast<Eigen::Index>(std::find(rigid.begin(), rigid.end(), a.mode) - rigid.begin());
+    a.paired_after = true;
+    a.model_hz_after = s.final_hz[j];
+    a.mac_after = s.final_mac[j];
+  }
+}
+
 }  // namespace
 
 namespace {
@@ -440,6 +505,7 @@ DiscoverySummary discover(const Model& model, const ModalData& measured, const D
     T->steps = e.steps;
     T->after = e.fit.quality;
     check_set_aside(p, measured, e.fit, &T->set_aside);
+    refit_with_rigid_body_modes(p, measured, e.fit, order, T);
     const Equivalents equivalent = name_equivalent_sites(p, e, singles, order, T);
     const OtherPhysics other = weigh_rivals(p, e, singles, recal, equivalent, T);
     decide(p, e, T);

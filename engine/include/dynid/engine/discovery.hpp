@@ -167,7 +167,8 @@ struct SetAside {
   /// kRigidBody: a free-free test's rigid-body motion on its suspension (below the first elastic mode, shaped
   /// like the model's rigid-body motions). kNoPartner: the model as given has no mode of that shape within the
   /// plausible frequency ratio (a local mode of what is missing, or a spurious identification); after discovery,
-  /// `paired_after` tells whether the findings predict it.
+  /// `paired_after` tells whether the findings predict it (kRigidBody: whether the findings include the suspension
+  /// and their values were refitted with this mode, which they then predict at `model_hz_after`).
   enum class Reason { kRigidBody, kNoPartner } reason = Reason::kRigidBody;
   double mac = 0;                  ///< kRigidBody: MAC with the rigid-body motions; kNoPartner: best MAC
   bool paired_after = false;
