@@ -306,6 +306,8 @@ TEST(Discovery, OneModeTestsButNamesNothing) {
   const DiscoverySummary d = discover(analysis, meas, o);
   EXPECT_EQ(d.verdict, Verdict::kInconclusive) << said(d);
   EXPECT_TRUE(d.findings.empty());
+  EXPECT_NE(discovery_explanation(d).find("from one measured mode no physics can be named"), std::string::npos)
+      << discovery_explanation(d);
   for (const DiscoverySummary* x : {&same, &d}) {
     bool warned = false;
     for (const std::string& w : x->warnings) warned = warned || w.find("only one measured mode") != std::string::npos;

@@ -191,6 +191,11 @@ std::string discovery_explanation(const DiscoverySummary& s) {
     case VerdictReason::kWithinNoise:
       return "No missing physics: the model fits the data within the noise (" + misfit_words(s) + ").";
     case VerdictReason::kNothingDecisive: {
+      if (s.candidates.empty() && !s.recalibration.fitted)  // discover() fits none to one mode
+        return "The model misfits the data (" + misfit_words(s) +
+               "), but from one measured mode no physics can be "
+               "named (any one-parameter candidate matches one frequency): more modes, from more or better-placed "
+               "sensors or a wider band, would tell the candidates apart.";
       std::string best = "none fitted";
       for (const ScoredHypothesis& h : s.candidates)
         if (h.fitted) {
