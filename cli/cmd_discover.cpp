@@ -45,11 +45,10 @@ void print_summary(const Case& c, const DiscoveryData& d, const DiscoverySummary
   for (const std::string& n : set_aside_words(s)) fmt::print("  note: {}\n", n);
   for (const std::string& w : s.warnings) fmt::print("  warning: {}\n", w);
   fmt::print("  1. where:  {}\n", localization_words(s));
-  if (s.candidates.empty() && !s.recalibration.fitted) {
-    fmt::print("  2-3. candidates: none fitted\n");
-  } else {
+  if (candidates_fitted(s))
     print_candidates(c, s);
-  }
+  else
+    fmt::print("  2-3. candidates: none fitted\n");
   if (s.steps.size() > 1) {
     fmt::print("  selection:\n");
     for (const SelectionStep& st : s.steps)

@@ -191,7 +191,7 @@ std::string discovery_explanation(const DiscoverySummary& s) {
     case VerdictReason::kWithinNoise:
       return "No missing physics: the model fits the data within the noise (" + misfit_words(s) + ").";
     case VerdictReason::kNothingDecisive: {
-      if (s.candidates.empty() && !s.recalibration.fitted)  // discover() fits none to one mode
+      if (!candidates_fitted(s))
         return "The model misfits the data (" + misfit_words(s) +
                "), but from one measured mode no physics can be "
                "named (any one-parameter candidate matches one frequency): more modes, from more or better-placed "
@@ -259,6 +259,8 @@ std::string localization_words(const DiscoverySummary& s) {
        to_string(L.nature) + "-like (residual alignment with inertia forces " + format_number(L.mass_alignment, 2) + ").";
   return w;
 }
+
+bool candidates_fitted(const DiscoverySummary& s) { return !s.candidates.empty() || s.recalibration.fitted; }
 
 std::vector<std::string> set_aside_words(const DiscoverySummary& s) {
   std::vector<std::string> out;

@@ -122,6 +122,14 @@ double chi2_quantile(int k, double alpha) {
   return std::max(k, 1) * std::pow(1 - c + z * std::sqrt(c), 3);
 }
 
+// The model with a fitted set installed (`first`: each candidate's first parameter), and its parameters at the fit.
+Eigen::VectorXd install_fitted(const SetFit& f, ParametricModel* pm, std::vector<int>* first) {
+  *first = install_candidates(pm, f.set);
+  Eigen::VectorXd th = pm->nominal();
+  for (std::size_t k = 0; k < f.set.size(); ++k) th.segment((*first)[k], f.theta[k].size()) = f.theta[k];
+  return th;
+}
+
 // Whether the findings make the model predict the measured modes the model as given had no partner for.
 void check_set_aside(const Problem& p, const ModalData& measured, const SetFit& f, std::vector<SetAside>* aside) {
   std::vector<int> idx;
@@ -132,9 +140,8 @@ void check_set_aside(const Problem& p, const ModalData& measured, const SetFit& 
   d.damping_ratios.resize(0), d.mpc.resize(0), d.frequency_std_hz.resize(0), d.damping_std.resize(0), d.shape_std.resize(0);
   d.shape_entry_std.resize(0, 0);
   ParametricModel pm(*p.model);
-  const std::vector<int> first = install_candidates(&pm, f.set);
-  Eigen::VectorXd th = pm.nominal();
-  for (std::size_t k = 0; k < f.set.size(); ++k) th.segment(first[k], f.theta[k].size()) = f.theta[k];
+  std::vector<int> first;
+  const Eigen::VectorXd th = install_fitted(f, &pm, &first);
   try {
     const Correlation c = correlate(pm, d, th, p.fit_for_other_modes());
     std::size_t k = 0;
@@ -158,19 +165,13 @@ void check_set_aside(const Problem& p, const ModalData& measured, const SetFit& 
 void refit_with_rigid_body_modes(const Problem& p, const ModalData& measured, const SetFit& f,
                                  const std::vector<std::size_t>& order, DiscoverySummary* T) {
   std::vector<int> rigid;
-  std::set<int> aside;
-  for (const SetAside& s : T->set_aside) {
-    aside.insert(s.mode);
+  for (const SetAside& s : T->set_aside)
     if (s.reason == SetAside::Reason::kRigidBody) rigid.push_back(s.mode);
-  }
   const bool suspension =
       std::any_of(f.set.begin(), f.set.end(), [](const Candidate* c) { return c->kind() == "suspension_stiffness"; });
   if (rigid.empty() || !suspension || !f.ok) return;
-  std::vector<int> keep;
-  for (int k = 0; k < measured.num_modes(); ++k)
-    if (!aside.count(k)) keep.push_back(k);
-  if (static_cast<int>(keep.size()) != p.modes) return;
   const int used = p.modes;
+  std::vector<int> keep = p.data_modes;
   keep.insert(keep.end(), rigid.begin(), rigid.end());  // the rigid-body modes last
   const ModalData d = modes_subset(measured, keep);
   FitOptions fo = p.fit;
@@ -182,9 +183,8 @@ void refit_with_rigid_body_modes(const Problem& p, const ModalData& measured, co
   extend(&fo.frequency_noise_modes, p.noise.frequency);
   extend(&fo.shape_noise_modes, p.noise.shape);
   ParametricModel pm(*p.model);
-  const std::vector<int> first = install_candidates(&pm, f.set);
-  Eigen::VectorXd theta0 = pm.nominal();
-  for (std::size_t k = 0; k < f.set.size(); ++k) theta0.segment(first[k], f.theta[k].size()) = f.theta[k];
+  std::vector<int> first;
+  const Eigen::VectorXd theta0 = install_fitted(f, &pm, &first);
   FitSummary s;
   try {
     s = fit_parameters(pm, d, theta0, {}, fo);

@@ -164,6 +164,7 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
   }
   std::sort(S->set_aside.begin(), S->set_aside.end(), [](const SetAside& a, const SetAside& b) { return a.mode < b.mode; });
   p.data = modes_subset(measured, keep);
+  p.data_modes = keep;
   p.modes = p.data.num_modes();
   p.noise = noise_model(p.data, o, &S->warnings);
   S->noise = p.noise;

@@ -23,6 +23,7 @@ struct Problem {
   const Model* model = nullptr;
   DiscoveryOptions options;
   ModalData data;                  ///< the measured modes used (set-aside ones removed)
+  std::vector<int> data_modes;     ///< their indices in the measured data
   /// The measured modes without a partner in the model as given (a local mode of what is missing, or a spurious
   /// identification), and per mode the most a hypothesis pairing it can gain in -2 ln L: the log ratio of the noise's
   /// normal density to the vague density an unpaired mode has (prepare.cpp); it earns that less its chi-square.

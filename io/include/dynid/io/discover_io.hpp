@@ -45,6 +45,8 @@ std::string site_label(const Site& s, const std::string& sep);
 std::string discovery_explanation(const DiscoverySummary& s);
 /// Where the residual forces are, and of what nature.
 std::string localization_words(const DiscoverySummary& s);
+/// Whether discover() fitted any candidate (none when a single measured mode pairs with the model).
+bool candidates_fitted(const DiscoverySummary& s);
 /// One sentence per measured mode set aside (a rigid-body mode on the suspension, a mode without a partner).
 std::vector<std::string> set_aside_words(const DiscoverySummary& s);
 
