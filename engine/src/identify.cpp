@@ -533,8 +533,30 @@ void reject_modes(IdentificationSummary& s, const std::vector<Rejection>& why, c
 // local; the joint fit may hand a pole that only fits a neighbour's residual error that neighbour's shape.
 void lscf_final_modes(const LscfInput& in, const FrfData& frf_in, double window_decay, const IdentificationOptions& o,
                       IdentificationSummary& s) {
-  for (int pass = 0; pass < 4; ++pass) {
+  // A mode whose cluster's shape matched a mode the model predicts keeps that shape (and counts as that mode) when
+  // the joint fit leaves its shape complex: the cluster's pole is the mode's, the joint residues are not.
+  std::vector<double> pre_hz(s.modes.size(), 0.0);
+  std::vector<Eigen::VectorXcd> pre_shape(s.modes.size());
+  for (std::size_t k = 0; k < s.modes.size(); ++k) {
+    const IdentifiedMode& m = s.modes[k];
+    const int e = m.expected_hz > 0 ? -1 : internal::expected_match(o, s.dofs, m.frequency_hz, m.shape);
+    pre_hz[k] = m.expected_hz > 0 ? m.expected_hz
+                : e >= 0          ? o.expected_modes[static_cast<std::size_t>(e)].frequency_hz
+                                  : 0.0;
+    pre_shape[k] = m.shape;
+  }
+  auto shapes = [&]() {
     lscf_mode_shapes(in, window_decay, o.min_cluster_fraction, s);
+    for (std::size_t k = 0; k < s.modes.size(); ++k) {
+      IdentifiedMode& m = s.modes[k];
+      if (!(pre_hz[k] > 0) || m.mpc >= o.min_mpc) continue;
+      if (!(m.expected_hz > 0)) m.expected_hz = pre_hz[k], m.expected_because = Rejection::kComplexShape;
+      m.shape = pre_shape[k];
+      finish_shape(m);
+    }
+  };
+  for (int pass = 0; pass < 4; ++pass) {
+    shapes();
     const std::size_t n = s.modes.size();
     std::vector<char> drop(n, 0);
     std::vector<Rejection> why(n, Rejection::kComplexShape);
@@ -565,8 +587,12 @@ void lscf_final_modes(const LscfInput& in, const FrfData& frf_in, double window_
       }
     if (std::find(drop.begin(), drop.end(), 1) == drop.end()) return;
     reject_modes(s, why, drop, value, limit, into);
+    std::size_t j = 0;
+    for (std::size_t k = 0; k < n; ++k)
+      if (!drop[k]) pre_hz[j] = pre_hz[k], pre_shape[j] = pre_shape[k], ++j;
+    pre_hz.resize(j), pre_shape.resize(j);
   }
-  lscf_mode_shapes(in, window_decay, o.min_cluster_fraction, s);
+  shapes();
 }
 
 // ---- SSI-cov stages -------------------------------------------------------------------------------------------

@@ -390,6 +390,11 @@ class ExpectedAtOutputs {
 };
 }  // namespace
 
+int expected_match(const IdentificationOptions& o, const std::vector<MeasuredDof>& outputs, double f,
+                   const Eigen::VectorXcd& shape) {
+  return o.expected_modes.empty() ? -1 : ExpectedAtOutputs(o, outputs).match(f, shape);
+}
+
 std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& cands,
                                                      const std::vector<IndicatorEvidence>& ev,
                                                      const std::vector<Eigen::VectorXd>& indicators,

@@ -216,11 +216,15 @@ namespace dynid {
 namespace {
 using internal::format_number;
 
-ModalData keep_modes(ModalData m, const DiscoverSpec& d, const std::string& source, std::vector<std::string>* notes) {
+// expected: per mode, whether the identification reported it as a mode the model predicts (its shape carries no
+// weight, so its MPC is no reason to leave it out); empty = none.
+ModalData keep_modes(ModalData m, const DiscoverSpec& d, const std::string& source, std::vector<std::string>* notes,
+                     const std::vector<char>& expected = {}) {
   std::vector<int> keep;
   std::string left_out;
   for (int k = 0; k < m.num_modes(); ++k) {
-    if (m.mpc.size() == m.frequencies_hz.size() && m.mpc[k] < d.min_mpc) {
+    const bool exempt = static_cast<std::size_t>(k) < expected.size() && expected[static_cast<std::size_t>(k)];
+    if (!exempt && m.mpc.size() == m.frequencies_hz.size() && m.mpc[k] < d.min_mpc) {
       const std::string what = format_number(m.frequencies_hz[k], 5) + " Hz (MPC " + format_number(m.mpc[k], 3) + ")";
       if (notes)
         notes->push_back("identified mode at " + what + " left out: MPC < " + format_number(d.min_mpc, 3) +
@@ -243,6 +247,14 @@ ModalData keep_modes(ModalData m, const DiscoverSpec& d, const std::string& sour
 }  // namespace
 
 namespace {
+// Per identified mode, whether it was reported as a mode the model predicts (keep_modes).
+std::vector<char> expected_flags(const DiscoveryData& out) {
+  std::vector<char> e;
+  if (out.identified)
+    for (const IdentifiedMode& m : out.identification.modes) e.push_back(m.expected_hz > 0);
+  return e;
+}
+
 // Identification of the recordings of a discover: case (the band the model implies unless the case gives one).
 void identify_recordings_for(const Case& c, std::vector<Recording> recs, DiscoveryData* out) {
   const DiscoverSpec& d = *c.discover;
@@ -267,13 +279,17 @@ void identify_recordings_for(const Case& c, std::vector<Recording> recs, Discove
   }
   out->identification = identify_recordings(std::move(recs), method, io);
   out->identified = true;
-  for (const IdentifiedMode& m : out->identification.modes)
-    if (m.expected_hz > 0)
-      out->notes.push_back("identified mode at " + format_number(m.frequency_hz, 5) + " Hz: stable over " +
-                           format_number(m.support, 2) + " of the orders (< " +
-                           format_number(io.min_cluster_fraction, 2) +
-                           "), reported because its shape matches the model's mode at " +
-                           format_number(m.expected_hz, 5) + " Hz (MAC >= " + format_number(io.expected_mac, 2) + ")");
+  for (const IdentifiedMode& m : out->identification.modes) {
+    if (!(m.expected_hz > 0)) continue;
+    const std::string weak = m.expected_because == Rejection::kComplexShape
+                                 ? "its shape complex when fitted beside the other modes (MPC < " +
+                                       format_number(io.min_mpc, 2) + "; its own fit's shape kept)"
+                                 : "stable over " + format_number(m.support, 2) + " of the orders (< " +
+                                       format_number(io.min_cluster_fraction, 2) + ")";
+    out->notes.push_back("identified mode at " + format_number(m.frequency_hz, 5) + " Hz: " + weak +
+                         ", reported because its shape matches the model's mode at " + format_number(m.expected_hz, 5) +
+                         " Hz (MAC >= " + format_number(io.expected_mac, 2) + ")");
+  }
   out->measured = out->identification.modal_data("identified from " + out->source);
   const Eigen::Index found = out->measured.num_modes();
   if (found < 1)
@@ -324,7 +340,7 @@ DiscoveryData discovery_data(const Case& c, int seed_offset) {
     }
     identify_recordings_for(c, std::move(recs), &out);
   }
-  out.measured = keep_modes(std::move(out.measured), d, out.source, &out.notes);
+  out.measured = keep_modes(std::move(out.measured), d, out.source, &out.notes, expected_flags(out));
   return out;
 }
 
@@ -342,7 +358,7 @@ DiscoveryData discovery_data(const Case& c, std::vector<Recording> recordings, c
   DiscoveryData out;
   out.source = source;
   identify_recordings_for(c, std::move(recordings), &out);
-  out.measured = keep_modes(std::move(out.measured), *c.discover, source, &out.notes);
+  out.measured = keep_modes(std::move(out.measured), *c.discover, source, &out.notes, expected_flags(out));
   return out;
 }
 

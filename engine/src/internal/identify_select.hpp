@@ -91,6 +91,11 @@ struct Candidate {
 /// merged into it; appends every rejected candidate to s.rejected. `evidence` gives each candidate's
 /// indicator_evidence on its own mode indicator `indicators` (on s.frequency_hz; the dip between two clusters is
 /// read on the stronger one's); `n_orders` the number of model orders.
+/// The model's mode (IdentificationOptions::expected_modes) a mode of frequency f and complex shape at `outputs`
+/// matches (within expected_ratio, MAC >= expected_mac over at least 3 shared outputs, the best), -1 for none.
+int expected_match(const IdentificationOptions& o, const std::vector<MeasuredDof>& outputs, double f,
+                   const Eigen::VectorXcd& shape);
+
 std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& candidates,
                                                      const std::vector<IndicatorEvidence>& evidence,
                                                      const std::vector<Eigen::VectorXd>& indicators,

@@ -124,6 +124,8 @@ struct IdentificationOptions {
   /// expected_ratio in frequency, and no mode already reported matches that one: a weak mode the model says is
   /// there, shaped as the model says, is not noise. Its frequency and damping stay the data's own; it carries
   /// IdentifiedMode::expected_hz, and its shape no weight in IdentificationSummary::modal_data (docs/method.md).
+  /// So does a mode whose cluster passed every check alone shaped like one of these when LSCF's joint LSFD of
+  /// all modes leaves its shape complex (MPC below min_mpc): it keeps its cluster's shape instead of being dropped.
   std::vector<ExpectedMode> expected_modes;
   double expected_fraction = 0.2, expected_mac = 0.9, expected_ratio = 1.15;
   // SSI-cov.
@@ -151,6 +153,16 @@ struct StabilizationPole {
   bool stable() const { return stable_frequency && stable_damping && stable_vector; }
 };
 
+/// Why a cluster of poles was not reported as a mode.
+enum class Rejection {
+  kFewOrders,        ///< support below min_cluster_fraction
+  kComplexShape,     ///< MPC below min_mpc
+  kIndicatorTrough,  ///< the mode indicator has no peak there (below min_peak_db)
+  kSpectralEdge,     ///< the mode indicator falls beside it faster than a resonance can (an excitation edge)
+  kSplit             ///< a split of a stronger cluster with the same shape (merged into it)
+};
+const char* to_string(Rejection r);  // "few orders", "complex shape", "no indicator peak", "spectral edge", "split"
+
 struct IdentifiedMode {
   double frequency_hz = 0, damping_ratio = 0;
   /// Standard deviations: the split-data estimate when there is one (header comment), else the spread over
@@ -160,9 +172,13 @@ struct IdentifiedMode {
   double shape_std = 0;  ///< std of the shape entries relative to the largest (split data; 0 = not estimated)
   int poles = 0;                                 ///< poles in its cluster (orders that found it)
   double support = 0;                            ///< weighted share of the orders (header comment, step 2)
-  /// The model's mode (IdentificationOptions::expected_modes) this one was reported as, its support short of
-  /// min_cluster_fraction; 0 = reported on its own evidence.
+  /// The model's mode (IdentificationOptions::expected_modes) this one was reported as, short of the evidence a
+  /// mode needs on its own; 0 = reported on its own evidence.
   double expected_hz = 0;
+  /// What it was short of: support (kFewOrders: its cluster stable over fewer than min_cluster_fraction of the
+  /// orders), or a normal mode's shape in the joint LSFD of all modes (kComplexShape: its cluster passed every
+  /// check alone, shaped like the model's mode; it keeps that shape, as its own pole's fit gave it).
+  Rejection expected_because = Rejection::kFewOrders;
   double indicator_db = 0;  ///< mode indicator above (+) or below (-) the line between its surroundings, dB
   Eigen::VectorXcd shape;                        ///< complex shape at the outputs (LSFD residues / SSI C psi)
   Eigen::VectorXd real_shape;                    ///< real-normalized (best real rotation), max |.| = 1
@@ -173,16 +189,6 @@ struct IdentifiedMode {
   int twin_of = -1;
   double twin_mac = 0;
 };
-
-/// Why a cluster of poles was not reported as a mode.
-enum class Rejection {
-  kFewOrders,        ///< support below min_cluster_fraction
-  kComplexShape,     ///< MPC below min_mpc
-  kIndicatorTrough,  ///< the mode indicator has no peak there (below min_peak_db)
-  kSpectralEdge,     ///< the mode indicator falls beside it faster than a resonance can (an excitation edge)
-  kSplit             ///< a split of a stronger cluster with the same shape (merged into it)
-};
-const char* to_string(Rejection r);  // "few orders", "complex shape", "no indicator peak", "spectral edge", "split"
 
 struct RejectedCluster {
   double frequency_hz = 0, damping_ratio = 0;
