@@ -49,7 +49,9 @@ void ExpectSameModes(const ModalResult& a, const ModalResult& b, double rtol) {
       EXPECT_GT(test::Mac(a.modes.col(k), b.modes.col(k)), 1 - 1e-10) << "mode " << k;
     }
   }
-  if (nr > 0) EXPECT_LT(test::SubspaceGap(a.modes.leftCols(nr), b.modes.leftCols(nr)), 1e-8);
+  if (nr > 0) {
+    EXPECT_LT(test::SubspaceGap(a.modes.leftCols(nr), b.modes.leftCols(nr)), 1e-8);
+  }
   EXPECT_LT(b.summary.max_residual, 1e-10);
 }
 

@@ -86,9 +86,16 @@ plot::Figure stabilization_figure(const IdentificationSummary& s, const std::str
   bg.width = 1.2;
   p.right.push_back(bg);
   // Pole classes, drawn from the least to the most stable.
-  plot::Series fresh{".  new or unstable pole", {}, {}, plot::Kind::kMarkers, 7}, f_only{"x  stable in frequency", {}, {}, plot::Kind::kMarkers, 1},
-      fd{"+  stable in frequency, damping", {}, {}, plot::Kind::kMarkers, 2},
-      all{"o  stable in frequency, damping, vector", {}, {}, plot::Kind::kMarkers, 0};
+  auto markers = [](const char* label, int color) {
+    plot::Series m;
+    m.label = label;
+    m.kind = plot::Kind::kMarkers;
+    m.color = color;
+    return m;
+  };
+  plot::Series fresh = markers(".  new or unstable pole", 7), f_only = markers("x  stable in frequency", 1),
+               fd = markers("+  stable in frequency, damping", 2),
+               all = markers("o  stable in frequency, damping, vector", 0);
   fresh.symbol = 1, fresh.symbol_scale = 1.6;
   f_only.symbol = 5, f_only.symbol_scale = 0.7;
   fd.symbol = 2, fd.symbol_scale = 0.8;
