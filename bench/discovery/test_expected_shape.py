@@ -8,32 +8,27 @@ that named the preload.
 Usage: test_expected_shape.py DYNID [WORKDIR]   (exit 0 when every check holds; ctest bench.discovery_expected_shape)
 """
 import json
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import generate  # noqa: E402
-import score     # noqa: E402
+import run  # noqa: E402
 
 
 def main():
     dynid = sys.argv[1]
     work = Path(sys.argv[2]) if len(sys.argv) > 2 else Path(tempfile.mkdtemp(prefix="dynid-expected-"))
     work.mkdir(parents=True, exist_ok=True)
-    rec = generate.make_case("dev", 187, work)
-    folder = work / rec["case"]
-    truth = json.loads((folder / "truth.json").read_text())
-    out = folder / "discover.json"
-    p = subprocess.run([dynid, "--threads", "1", "discover", str(folder), "--json", str(out),
-                        "--plot", str(folder / "discover.png"), "--force"], capture_output=True, text=True)
-    failures = []
-    if p.returncode not in (0, 4) or not out.exists():
-        print(p.stdout, p.stderr)
-        print(f"FAIL: dynid discover exit {p.returncode}")
+    # Generate, run dynid and score as the benchmark does (recordings kept, so that the case can be looked at).
+    sc = run.run_case((None, "dev", 187, dict(out=str(work), dynid=dynid, timeout=120, keep=True)))
+    if sc["failure"]:
+        print(f"FAIL: {sc['failure']}")
         return 1
-    result = json.loads(out.read_text())
+    folder = work / sc["case"]
+    truth = json.loads((folder / "truth.json").read_text())
+    result = json.loads((folder / "discover.json").read_text())
+    failures = []
     notes = [w for w in json.dumps(result).split('"') if "its shape complex when fitted beside the other modes" in w]
     print("notes:", notes)
     if not any("12.96" in n for n in notes):
@@ -44,7 +39,6 @@ def main():
     f_truth = min((m["frequency_hz"] for m in truth["modes"]), key=lambda f: abs(f - 12.965))
     if not any(abs(f / f_truth - 1) < 1e-3 for f in measured):
         failures.append(f"no measured mode within 0.1 % of the truth mode at {f_truth:.4f} Hz: {measured}")
-    sc = score.score(truth, result)
     print("dynid said:", sc["said"])
     if not sc["named_right"]:
         failures.append("the preload is not named first")

@@ -535,15 +535,11 @@ void lscf_final_modes(const LscfInput& in, const FrfData& frf_in, double window_
                       IdentificationSummary& s) {
   // A mode whose cluster's shape matched a mode the model predicts keeps that shape (and counts as that mode) when
   // the joint fit leaves its shape complex: the cluster's pole is the mode's, the joint residues are not.
-  std::vector<double> pre_hz(s.modes.size(), 0.0);
+  std::vector<double> pre_hz = internal::expected_frequencies(o, s);
   std::vector<Eigen::VectorXcd> pre_shape(s.modes.size());
   for (std::size_t k = 0; k < s.modes.size(); ++k) {
-    const IdentifiedMode& m = s.modes[k];
-    const int e = m.expected_hz > 0 ? -1 : internal::expected_match(o, s.dofs, m.frequency_hz, m.shape);
-    pre_hz[k] = m.expected_hz > 0 ? m.expected_hz
-                : e >= 0          ? o.expected_modes[static_cast<std::size_t>(e)].frequency_hz
-                                  : 0.0;
-    pre_shape[k] = m.shape;
+    if (s.modes[k].expected_hz > 0) pre_hz[k] = s.modes[k].expected_hz;
+    pre_shape[k] = s.modes[k].shape;
   }
   auto shapes = [&]() {
     lscf_mode_shapes(in, window_decay, o.min_cluster_fraction, s);

@@ -390,9 +390,15 @@ class ExpectedAtOutputs {
 };
 }  // namespace
 
-int expected_match(const IdentificationOptions& o, const std::vector<MeasuredDof>& outputs, double f,
-                   const Eigen::VectorXcd& shape) {
-  return o.expected_modes.empty() ? -1 : ExpectedAtOutputs(o, outputs).match(f, shape);
+std::vector<double> expected_frequencies(const IdentificationOptions& o, const IdentificationSummary& s) {
+  std::vector<double> hz(s.modes.size(), 0.0);
+  if (o.expected_modes.empty()) return hz;
+  const ExpectedAtOutputs expected(o, s.dofs);
+  for (std::size_t k = 0; k < s.modes.size(); ++k) {
+    const int e = expected.match(s.modes[k].frequency_hz, s.modes[k].shape);
+    if (e >= 0) hz[k] = o.expected_modes[static_cast<std::size_t>(e)].frequency_hz;
+  }
+  return hz;
 }
 
 std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& cands,

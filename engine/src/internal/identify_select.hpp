@@ -83,6 +83,11 @@ struct Candidate {
   double strength = 0;  ///< which of two splits is the stronger (ClusterShape::strength, else support)
 };
 
+/// Per mode of s (its frequency and complex shape at s.dofs): the frequency of the model's mode
+/// (IdentificationOptions::expected_modes) it matches (within expected_ratio, MAC >= expected_mac over at least 3
+/// shared outputs, the best), 0 for none.
+std::vector<double> expected_frequencies(const IdentificationOptions& o, const IdentificationSummary& s);
+
 /// Step 3: the checks, on candidates with shapes (those without one, below the shaping limit, are rejected for
 /// their support). Splits are merged first (a weaker cluster with the same shape joins the stronger when within
 /// the merge window, or within merge_span with no indicator dip of min_peak_db between them), then each group is
@@ -91,11 +96,6 @@ struct Candidate {
 /// merged into it; appends every rejected candidate to s.rejected. `evidence` gives each candidate's
 /// indicator_evidence on its own mode indicator `indicators` (on s.frequency_hz; the dip between two clusters is
 /// read on the stronger one's); `n_orders` the number of model orders.
-/// The model's mode (IdentificationOptions::expected_modes) a mode of frequency f and complex shape at `outputs`
-/// matches (within expected_ratio, MAC >= expected_mac over at least 3 shared outputs, the best), -1 for none.
-int expected_match(const IdentificationOptions& o, const std::vector<MeasuredDof>& outputs, double f,
-                   const Eigen::VectorXcd& shape);
-
 std::vector<std::vector<std::size_t>> check_evidence(const std::vector<Candidate>& candidates,
                                                      const std::vector<IndicatorEvidence>& evidence,
                                                      const std::vector<Eigen::VectorXd>& indicators,
