@@ -667,6 +667,59 @@ TEST(Candidates, PreloadOnlyWhereALackOfFitMeetsARestraint) {
                                    "axial preload (geometric stiffness) in the members of group 'beam'"}));
 }
 
+// A preload is the self-stress of its group's lack of fit, carried by every member it pulls on: a line pinned at
+// both ends, a 'tie' of four frame2d elements (1.5 m) in series with a 'beam' of four (2.5 m, three times the tie's
+// area). Shortening the tie stretches the beam by as much as the tie's own shortening fails to happen: the same
+// tension in all eight elements (equilibrium of a chain, whatever the areas). The tie's candidate at a mean force
+// P must give the eigenvalues of the model whose eight elements carry P through the element kernel's own axial
+// force (an independent route: no static analysis), to 1e-10. Before, only the tie's elements carried P: the lowest
+// eigenvalue came out 3.1 % low.
+TEST(Candidates, APreloadLoadsEveryMemberItPullsOn) {
+  auto line = [](double force) {
+    Model m;
+    m.add_material(steel());
+    for (int k = 0; k < 2; ++k) {
+      Section s;
+      s.name = k == 0 ? "tie" : "beam";
+      s.A = k == 0 ? 2e-4 : 6e-4;
+      s.Iz = k == 0 ? 2e-9 : 6e-9;
+      m.add_section(s);
+    }
+    for (int k = 0; k <= 8; ++k) m.add_node(k + 1, Eigen::Vector3d(k < 4 ? 0.375 * k : 1.5 + 0.625 * (k - 4), 0, 0));
+    for (int k = 1; k <= 8; ++k) {
+      Element e;
+      e.id = k;
+      e.node_ids = {{k, k + 1}};
+      e.material = 0;
+      e.section = k <= 4 ? 0 : 1;
+      e.group = k <= 4 ? "tie" : "beam";
+      e.axial_force = force;
+      m.add_element(e);
+    }
+    m.restrain(1, dof_bit(Dof::UX) | dof_bit(Dof::UY));
+    m.restrain(9, dof_bit(Dof::UX) | dof_bit(Dof::UY));
+    m.finalize();
+    return m;
+  };
+  const Model m = line(0.0);
+  const double P = 40.0;  // N: the lowest eigenvalue moves by several per cent
+  int checked = 0;
+  for (const auto& c : candidate_library(m, exact_modes(m, m, 4), DiscoveryOptions{})) {
+    if (c->kind() != "axial_preload" || c->description().find("'tie'") == std::string::npos) continue;
+    const Eigen::VectorXd th =
+        Eigen::VectorXd::Constant(1, P / c->physical(Eigen::VectorXd::Ones(1), Eigen::VectorXd::Zero(1))[0].value);
+    EigenOptions eo;
+    eo.num_modes = 5;
+    eo.method = EigenOptions::Method::kDense;
+    const Eigen::VectorXd want = modal_analysis(line(P), eo).eigenvalues;
+    const Eigen::VectorXd got = eigen_with(m, *c, th, 5);
+    EXPECT_LT(((got - want).array() / want.array()).abs().maxCoeff(), 1e-10)
+        << got.transpose() << " vs " << want.transpose();
+    ++checked;
+  }
+  EXPECT_EQ(checked, 1);
+}
+
 // A support's stiffness against the model's idealisation is one physics, seen from either side: a clamp less than
 // rigid (flexible_support) or a pin more than free (rotational_spring, only at supported nodes). On a simply
 // supported beam the rotational springs are the two pins' and share flexible_support's physics; the translational
