@@ -720,6 +720,45 @@ TEST(Candidates, APreloadLoadsEveryMemberItPullsOn) {
   EXPECT_EQ(checked, 1);
 }
 
+// The lack of fit sits where its self-stress is largest. Three steel bars meet at node P: 'a' hangs it from a
+// support 1 m below, the two bars of 'b' run to supports 2 m either side and 0.2 m up (sin alpha = 0.0995).
+// Shortening 'a' pulls P down, and the shallow bars hold it with N = T / (2 sin alpha) = 5 T: the state of a lack
+// of fit in 'a' is largest in 'b', so 'a' gets no candidate (that is a lack of fit of 'b', whose own state loads
+// 'a' with 2 N sin alpha = 0.2 N). Closed-form statics of a pin-jointed truss; the bars are frame2d members meshed
+// in two elements each, whose bending changes these ratios by far less than the factor of 5 the test rests on.
+TEST(Candidates, ALackOfFitSitsWhereItsForcesAreLargest) {
+  Model m;
+  m.add_material(steel());
+  Section s;
+  s.name = "s";
+  s.A = 1e-3;
+  s.Iz = 1e-8;
+  m.add_section(s);
+  const std::vector<Eigen::Vector3d> x = {{0, 0, 0}, {0, -1, 0}, {-2, 0.2, 0}, {2, 0.2, 0}};
+  for (int k = 0; k < 4; ++k) m.add_node(k + 1, x[k]);
+  int id = 0;
+  for (int far = 2; far <= 4; ++far) {  // P -> mid-node -> support
+    const int mid = 10 + far;
+    m.add_node(mid, 0.5 * (x[0] + x[far - 1]));
+    for (const std::array<int, 2>& ends : {std::array<int, 2>{1, mid}, std::array<int, 2>{mid, far}}) {
+      Element e;
+      e.id = ++id;
+      e.node_ids = ends;
+      e.material = 0;
+      e.section = 0;
+      e.group = far == 2 ? "a" : "b";
+      m.add_element(e);
+    }
+    m.restrain(far, kAllDofs);
+  }
+  m.finalize();
+  std::set<std::string> groups;
+  for (const auto& c : candidate_library(m, exact_modes(m, m, 4), DiscoveryOptions{}))
+    if (c->kind() == "axial_preload") groups.insert(c->description());
+  EXPECT_EQ(groups, (std::set<std::string>{"axial preload (geometric stiffness) in all members",
+                                           "axial preload (geometric stiffness) in the members of group 'b'"}));
+}
+
 // A support's stiffness against the model's idealisation is one physics, seen from either side: a clamp less than
 // rigid (flexible_support) or a pin more than free (rotational_spring, only at supported nodes). On a simply
 // supported beam the rotational springs are the two pins' and share flexible_support's physics; the translational
