@@ -159,13 +159,15 @@ class NonStructuralMass : public OnElements {
   double mass_ = 0, per_length_ = 0;
 };
 
-// One candidate C on all members and on each group, for the groups `admits` (elements -> bool) lets through.
-template <class C, class Admits>
-std::vector<std::unique_ptr<Candidate>> per_group(const CandidateContext& c, const Admits& admits) {
+// One candidate on all members and on each group: `make(group, elements)` gives it, or nullptr where the group
+// cannot have one.
+template <class Make>
+std::vector<std::unique_ptr<Candidate>> per_group(const CandidateContext& c, const Make& make) {
   std::vector<std::unique_ptr<Candidate>> out;
   for (const std::string& g : member_groups(*c.model)) {
     std::vector<int> els = group_members(*c.model, g);
-    if (!els.empty() && admits(els)) out.push_back(std::make_unique<C>(c, g, std::move(els)));
+    if (els.empty()) continue;
+    if (std::unique_ptr<Candidate> x = make(g, std::move(els))) out.push_back(std::move(x));
   }
   return out;
 }
@@ -270,21 +272,20 @@ CandidateKind axial_preload_kind() {
   return {"axial_preload", Nature::kStiffness, "an axial force (geometric stiffness) in all members or one group",
           [](const CandidateContext& c) {
             const SelfStress self_stress(*c.model);
-            std::vector<std::unique_ptr<Candidate>> out;
-            for (const std::string& g : member_groups(*c.model)) {
-              std::vector<int> els = group_members(*c.model, g);
-              if (els.empty()) continue;
-              if (auto state = self_stress.preload(els))
-                out.push_back(std::make_unique<AxialPreload>(c, g, std::move(els), std::move(*state)));
-            }
-            return out;
+            return per_group(c, [&](const std::string& g, std::vector<int> els) -> std::unique_ptr<Candidate> {
+              std::optional<PreloadState> state = self_stress.preload(els);
+              if (!state) return nullptr;
+              return std::make_unique<AxialPreload>(c, g, std::move(els), std::move(*state));
+            });
           }};
 }
 
 CandidateKind distributed_mass_kind() {
   return {"distributed_mass", Nature::kMass, "non-structural mass spread over all members or one group",
           [](const CandidateContext& c) {
-            return per_group<NonStructuralMass>(c, [](const std::vector<int>&) { return true; });
+            return per_group(c, [&](const std::string& g, std::vector<int> els) -> std::unique_ptr<Candidate> {
+              return std::make_unique<NonStructuralMass>(c, g, std::move(els));
+            });
           }};
 }
 
