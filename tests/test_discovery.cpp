@@ -617,6 +617,14 @@ TEST(Candidates, SemiRigidJointsOnlyWhereMembersMeet) {
   EXPECT_EQ(at, joints);
 }
 
+// The axial_preload candidates the library places on `m` (data: its own first `modes` modes), by description.
+std::set<std::string> preload_groups(const Model& m, int modes = 3) {
+  std::set<std::string> g;
+  for (const auto& c : candidate_library(m, exact_modes(m, m, modes), DiscoveryOptions{}))
+    if (c->kind() == "axial_preload") g.insert(c->description());
+  return g;
+}
+
 // A preload is a self-stress: only members whose lack of fit meets a restraint can carry one (the axial_preload
 // candidate's placement, group_effects.cpp). The groups that get the candidate, by closed-form statics:
 // - a vertical mast of frame elements clamped at its base expands freely (none); pinned at its top as well, it
@@ -625,12 +633,6 @@ TEST(Candidates, SemiRigidJointsOnlyWhereMembersMeet) {
 // - the portal (2 x 2 bays, equal stories): its beams are held by the columns (all members and 'beam'), while an
 //   equal elongation of every column lifts the floors rigidly (no force: 'column' gets none).
 TEST(Candidates, PreloadOnlyWhereALackOfFitMeetsARestraint) {
-  auto preload_groups = [](const Model& m) {
-    std::set<std::string> g;
-    for (const auto& c : candidate_library(m, exact_modes(m, m, 3), DiscoveryOptions{}))
-      if (c->kind() == "axial_preload") g.insert(c->description());
-    return g;
-  };
   auto mast = [](bool pinned_top) {
     Model m;
     m.add_material(steel());
@@ -752,11 +754,9 @@ TEST(Candidates, ALackOfFitSitsWhereItsForcesAreLargest) {
     m.restrain(far, kAllDofs);
   }
   m.finalize();
-  std::set<std::string> groups;
-  for (const auto& c : candidate_library(m, exact_modes(m, m, 4), DiscoveryOptions{}))
-    if (c->kind() == "axial_preload") groups.insert(c->description());
-  EXPECT_EQ(groups, (std::set<std::string>{"axial preload (geometric stiffness) in all members",
-                                           "axial preload (geometric stiffness) in the members of group 'b'"}));
+  EXPECT_EQ(preload_groups(m, 4),
+            (std::set<std::string>{"axial preload (geometric stiffness) in all members",
+                                   "axial preload (geometric stiffness) in the members of group 'b'"}));
 }
 
 // A support's stiffness against the model's idealisation is one physics, seen from either side: a clamp less than
