@@ -1,11 +1,14 @@
 // Eigen-solvers: the sparse shift-invert Lanczos path against the dense path (1e-8 relative) on every model
 // small enough for the dense path; free-free structures, singular mass matrices, band mode, mechanisms.
+#include <omp.h>
+
 #include <Eigen/Dense>
 #include <random>
 
 #include "dynid/engine/modal.hpp"
 #include "dynid/io/case_file.hpp"
 #include "dynid/mesh/generators.hpp"
+#include "dynid/solvers/cholmod.hpp"
 #include "internal/lanczos.hpp"
 #include "test_util.hpp"
 
@@ -172,6 +175,83 @@ TEST(Eigen, RejectsNonFiniteMatrices) {
   K.insert(1, 1) = std::nan("");
   M.insert(0, 0) = M.insert(1, 1) = 1;
   EXPECT_THROW(solve_eigen(K, M, EigenOptions{}), InputError);
+}
+
+// The two-core triangular solves of a simplicial factor (tree_solve.hpp; a plane frame of 40 x 40 bays, members in
+// 4 elements: 34,440 DOFs, the factor CHOLMOD chooses for short columns) against CHOLMOD's own solve of the same
+// factor (solve_block): the same x to 1e-12 relative (both are backward-stable triangular solves with one factor;
+// they differ by the order of their sums, ~ cond(L) eps with cond(L) = sqrt(cond(K)) ~ 1e4 here), a residual
+// |K x - b| / |b| below 1e-8 (cond(K) eps ~ 1e-8 is what any solve reaches), and bitwise the same x with one thread
+// and with two (the split does not depend on the thread count). CHOLMOD's own solves stay below pair.hpp's 20,000
+// rows (the same frame with 20 x 20 bays) and for a supernodal factor (3D frame of 16 x 16 x 16 bays).
+TEST(Eigen, TwoCoreSimplicialSolvesMatchCholmodForAnyThreadCount) {
+  const AssembledSystem sys = assemble_system(make_frame2d(Frame2D(40, 40, 4)));
+  CholmodFactor F;
+  F.analyze(sys.K);
+  ASSERT_TRUE(F.factorize(sys.K));
+  ASSERT_TRUE(F.parallel_solves());
+  const Eigen::Index n = sys.K.rows();
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Eigen::VectorXd b(n);
+  for (Eigen::Index i = 0; i < n; ++i) b[i] = u(rng);
+  const int saved = omp_get_max_threads();
+  Eigen::VectorXd x[2];
+  for (int threads : {1, 2}) {
+    omp_set_num_threads(threads);
+    Eigen::VectorXd& xt = x[threads - 1];
+    xt.resize(n);
+    F.forward(b.data(), xt.data());
+    F.backward(xt.data(), xt.data());
+  }
+  omp_set_num_threads(saved);
+  EXPECT_EQ((x[0] - x[1]).cwiseAbs().maxCoeff(), 0.0);
+  Eigen::MatrixXd ref;
+  F.solve_block(b, &ref);
+  EXPECT_LT((x[1] - ref.col(0)).norm(), 1e-12 * ref.norm());
+  EXPECT_LT((sys.K.selfadjointView<Eigen::Upper>() * x[1] - b).norm(), 1e-8 * b.norm());
+  Eigen::VectorXd y(n);
+  F.solve(b.data(), y.data());
+  EXPECT_EQ((y - x[1]).cwiseAbs().maxCoeff(), 0.0);
+
+  const Model small = make_frame2d(Frame2D(20, 20, 4)), supernodal = make_frame3d(test::SteelFrame3D(16, 16, 16));
+  ASSERT_LT(small.num_dofs(), 20000);
+  ASSERT_GE(supernodal.num_dofs(), 20000);
+  for (const Model* m : {&small, &supernodal}) {
+    const AssembledSystem other = assemble_system(*m);
+    CholmodFactor G;
+    G.analyze(other.K);
+    ASSERT_TRUE(G.factorize(other.K));
+    EXPECT_FALSE(G.parallel_solves()) << other.K.rows();
+  }
+}
+
+// The Lanczos steps' vector work on two row halves (LanczosOptions::pair_vectors): the same Ritz pairs, bitwise,
+// with one thread and with two, and the known eigenvalues (a diagonal operator of 30,000 rows) to the Lanczos
+// tolerance.
+TEST(Lanczos, SameRitzPairsOnOneThreadAndTwo) {
+  const Eigen::Index n = 30000;
+  Eigen::VectorXd d(n);
+  for (Eigen::Index i = 0; i < n; ++i) d[i] = 1.0 / (1.0 + static_cast<double>(i));
+  auto diag = [&](const double* x, double* y) {
+    for (Eigen::Index i = 0; i < n; ++i) y[i] = d[i] * x[i];
+  };
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Eigen::VectorXd v0(n);
+  for (Eigen::Index i = 0; i < n; ++i) v0[i] = u(rng);
+  const int saved = omp_get_max_threads();
+  detail::LanczosResult r[2];
+  for (int threads : {1, 2}) {
+    omp_set_num_threads(threads);
+    r[threads - 1] = detail::thick_restart_lanczos(diag, n, v0, detail::LanczosOptions{6, 20, 200, 1e-10, true});
+  }
+  omp_set_num_threads(saved);
+  ASSERT_TRUE(r[0].converged);
+  ASSERT_TRUE(r[1].converged);
+  EXPECT_EQ((r[0].theta - r[1].theta).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ((r[0].Y - r[1].Y).cwiseAbs().maxCoeff(), 0.0);
+  for (Eigen::Index i = 0; i < 6; ++i) EXPECT_NEAR(r[1].theta[i], d[i], 1e-10 * d[i]) << i;
 }
 
 // The thick-restart Lanczos on operators whose answer is known. A diagonal operator with 5 distinct values,

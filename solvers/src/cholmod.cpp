@@ -7,6 +7,8 @@
 #include <string>
 
 #include "dynid/mesh/error.hpp"
+#include "internal/pair.hpp"
+#include "internal/tree_solve.hpp"
 
 namespace dynid {
 
@@ -16,6 +18,8 @@ struct CholmodFactor::Impl {
   mutable cholmod_dense* X = nullptr;
   mutable cholmod_dense* Y = nullptr;
   mutable cholmod_dense* E = nullptr;
+  detail::TreeSolve tree;           // simplicial L L^T solves of one right-hand side on two cores (tree_solve.hpp)
+  mutable Eigen::VectorXd scratch;  // the permuted right-hand side of those solves
   Impl() { cholmod_start(&c); }
   ~Impl() {
     if (L) cholmod_free_factor(&L, &c);
@@ -90,11 +94,14 @@ bool CholmodFactor::factorize(const SparseMatrix& A) {
     throw NumericalError("CHOLMOD factorization failed (status " + std::to_string(c.status) +
                          (c.status == CHOLMOD_OUT_OF_MEMORY ? ": out of memory" : "") + ")");
   cholmod_factor* L = impl_->L;
+  impl_->tree = detail::TreeSolve();
   if (c.status == CHOLMOD_NOT_POSDEF || L->minor < L->n) {
     const size_t k = std::min<size_t>(L->minor, L->n - 1);
     failed_ = L->Perm ? static_cast<int*>(L->Perm)[k] : static_cast<int>(k);
     return false;
   }
+  // Two-core solves for large simplicial factors (tree_solve.hpp); CHOLMOD's own below pair.hpp's kPairRows.
+  if (kind_ == Kind::kSupernodalLLt && n_ >= detail::kPairRows) impl_->tree = detail::TreeSolve(L);
   return true;
 }
 
@@ -115,18 +122,41 @@ void CholmodFactor::solve_sys(int sys, const double* b, double* x, int ncol) con
   std::memcpy(x, impl_->X->x, sizeof(double) * static_cast<size_t>(n_) * static_cast<size_t>(ncol));
 }
 
-void CholmodFactor::solve(const double* b, double* x) const { solve_sys(CHOLMOD_A, b, x); }
+void CholmodFactor::solve(const double* b, double* x) const {
+  if (!impl_->tree.ok()) return solve_sys(CHOLMOD_A, b, x);
+  forward(b, x);
+  backward(x, x);
+}
 
 void CholmodFactor::forward(const double* b, double* x) const {
   if (kind_ != Kind::kSupernodalLLt) throw InternalError("CholmodFactor::forward needs an LL^T factor");
-  solve_sys(CHOLMOD_P, b, x);
-  solve_sys(CHOLMOD_L, x, x);
+  if (!impl_->tree.ok()) {
+    solve_sys(CHOLMOD_P, b, x);
+    solve_sys(CHOLMOD_L, x, x);
+    return;
+  }
+  // x = L^{-1} P b: (P b)[k] = b[Perm[k]] (b and x may alias).
+  const int* perm = static_cast<const int*>(impl_->L->Perm);
+  Eigen::VectorXd& y = impl_->scratch;
+  y.resize(n_);
+  for (int k = 0; k < n_; ++k) y[k] = b[perm ? perm[k] : k];
+  impl_->tree.forward(y.data());
+  std::copy(y.data(), y.data() + n_, x);
 }
 
 void CholmodFactor::backward(const double* b, double* x) const {
   if (kind_ != Kind::kSupernodalLLt) throw InternalError("CholmodFactor::backward needs an LL^T factor");
-  solve_sys(CHOLMOD_Lt, b, x);
-  solve_sys(CHOLMOD_Pt, x, x);
+  if (!impl_->tree.ok()) {
+    solve_sys(CHOLMOD_Lt, b, x);
+    solve_sys(CHOLMOD_Pt, x, x);
+    return;
+  }
+  // x = P^T L^{-T} b: x[Perm[k]] = (L^{-T} b)[k].
+  const int* perm = static_cast<const int*>(impl_->L->Perm);
+  Eigen::VectorXd& y = impl_->scratch;
+  y = Eigen::Map<const Eigen::VectorXd>(b, n_);
+  impl_->tree.backward(y.data());
+  for (int k = 0; k < n_; ++k) x[perm ? perm[k] : k] = y[k];
 }
 
 void CholmodFactor::solve_block(const Eigen::MatrixXd& B, Eigen::MatrixXd* X) const {
@@ -155,6 +185,8 @@ int CholmodFactor::negative_pivots() const {
     if (x[p[j]] < 0) ++neg;
   return neg;
 }
+
+bool CholmodFactor::parallel_solves() const { return impl_->tree.ok(); }
 
 long long CholmodFactor::factor_nonzeros() const {
   const cholmod_common& c = impl_->c;

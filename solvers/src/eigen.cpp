@@ -583,9 +583,9 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
       if (standard) {
         TransformedOperator op(F, Mp, Yr);
         op.perform_op(x0.data(), v0.data());
-        detail::LanczosResult lr =
-            detail::thick_restart_lanczos([&](const double* x, double* y) { op.perform_op(x, y); }, n, v0,
-                                          detail::LanczosOptions{want, ncv, opt.max_restarts, opt.tolerance});
+        detail::LanczosResult lr = detail::thick_restart_lanczos(
+            [&](const double* x, double* y) { op.perform_op(x, y); }, n, v0,
+            detail::LanczosOptions{want, ncv, opt.max_restarts, opt.tolerance, F.parallel_solves()});
         sum.solves += op.count();
         sum.restarts += lr.restarts;
         // A range with fewer dimensions than wanted (fewer massive DOFs): every finite mode, as the dense path.

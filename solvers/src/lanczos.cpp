@@ -7,28 +7,110 @@
 #include <random>
 #include <vector>
 
+#include "internal/pair.hpp"
+
 namespace dynid::detail {
 
 namespace {
 
 constexpr double kEta = 0.7071067811865476;  // DGKS: repeat the pass when it removed more than 1 - 1/sqrt(2)
 
+// With LanczosOptions::pair_vectors (the operator's solves run on two cores, tree_solve.hpp), the basis's vector
+// work runs on two fixed row halves at once (pair.hpp): the sums over the rows (dots, projections) are the halves'
+// sums added in a fixed order, so the result does not depend on the thread count, and it does not go through the
+// optimized BLAS, whose threads spin-yield after each call and slowed the two-core solves between the steps
+// (bench/README.md, "Two-core Lanczos steps"). Otherwise the whole vectors through Eigen and the BLAS, as always.
+template <class F>
+void halves(Eigen::Index n, F&& f) {
+  const Eigen::Index h = n / 2;
+  run_pair([&] { f(0, 0, h); }, [&] { f(1, h, n - h); });
+}
+
+// c = V^T w over `cols` columns of a row block (V column-major, leading dimension ld; len rows): four columns at a
+// time, so that w is read once per four. AVX2 where the CPU has it (target_clones), plain SSE2 otherwise.
+__attribute__((target_clones("avx2", "default"))) void project(const double* V, Eigen::Index ld, Eigen::Index cols,
+                                                               const double* w, Eigen::Index len, double* c) {
+  Eigen::Index j = 0;
+  for (; j + 4 <= cols; j += 4) {
+    const double *a = V + j * ld, *b = a + ld, *e = b + ld, *d = e + ld;
+    double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+#pragma omp simd reduction(+ : s0, s1, s2, s3)
+    for (Eigen::Index i = 0; i < len; ++i) {
+      const double wi = w[i];
+      s0 += a[i] * wi, s1 += b[i] * wi, s2 += e[i] * wi, s3 += d[i] * wi;
+    }
+    c[j] = s0, c[j + 1] = s1, c[j + 2] = s2, c[j + 3] = s3;
+  }
+  for (; j < cols; ++j) {
+    const double* a = V + j * ld;
+    double s0 = 0;
+#pragma omp simd reduction(+ : s0)
+    for (Eigen::Index i = 0; i < len; ++i) s0 += a[i] * w[i];
+    c[j] = s0;
+  }
+}
+
+// w -= V c over `cols` columns of a row block, four columns at a time; returns ||w||^2 of the block after.
+__attribute__((target_clones("avx2", "default"))) double subtract(const double* V, Eigen::Index ld, Eigen::Index cols,
+                                                                  const double* c, double* w, Eigen::Index len) {
+  Eigen::Index j = 0;
+  for (; j + 4 <= cols; j += 4) {
+    const double *a = V + j * ld, *b = a + ld, *e = b + ld, *d = e + ld;
+    const double c0 = c[j], c1 = c[j + 1], c2 = c[j + 2], c3 = c[j + 3];
+#pragma omp simd
+    for (Eigen::Index i = 0; i < len; ++i) w[i] -= a[i] * c0 + b[i] * c1 + e[i] * c2 + d[i] * c3;
+  }
+  for (; j < cols; ++j) {
+    const double* a = V + j * ld;
+    const double c0 = c[j];
+#pragma omp simd
+    for (Eigen::Index i = 0; i < len; ++i) w[i] -= a[i] * c0;
+  }
+  double sq = 0;
+#pragma omp simd reduction(+ : sq)
+  for (Eigen::Index i = 0; i < len; ++i) sq += w[i] * w[i];
+  return sq;
+}
+
 // w <- w - V h with h = V^T w over the first `cols` columns, repeated while a pass shrinks w below kEta of its
 // norm before the pass (at most 3 passes). Adds the coefficients to `h` (size cols, zeroed unless `keep`) and
-// returns ||w||.
+// returns ||w||. `before`: ||w|| if known (negative: computed here).
 double orthogonalize(const Eigen::MatrixXd& V, Eigen::Index cols, Eigen::VectorXd& w, Eigen::VectorXd& h,
-                     bool keep = false) {
+                     bool keep = false, double before = -1, bool pair = false) {
+  const Eigen::Index n = w.size();
   if (!keep) h.setZero(cols);
-  double before = w.norm();
+  if (!pair) {
+    if (before < 0) before = w.norm();
+    for (int pass = 0; pass < 3; ++pass) {
+      const Eigen::VectorXd c = V.leftCols(cols).transpose() * w;
+      w.noalias() -= V.leftCols(cols) * c;
+      h += c;
+      const double after = w.norm();
+      if (after >= kEta * before) return after;
+      before = after;
+    }
+    return w.norm();
+  }
+  Eigen::MatrixXd part(cols, 2);
+  double sq[2];
+  if (before < 0) {
+    halves(n, [&](int k, Eigen::Index lo, Eigen::Index len) { sq[k] = w.segment(lo, len).squaredNorm(); });
+    before = std::sqrt(sq[0] + sq[1]);
+  }
   for (int pass = 0; pass < 3; ++pass) {
-    const Eigen::VectorXd c = V.leftCols(cols).transpose() * w;
-    w.noalias() -= V.leftCols(cols) * c;
+    halves(n, [&](int k, Eigen::Index lo, Eigen::Index len) {
+      project(V.data() + lo, V.rows(), cols, w.data() + lo, len, part.col(k).data());
+    });
+    const Eigen::VectorXd c = part.col(0) + part.col(1);
+    halves(n, [&](int k, Eigen::Index lo, Eigen::Index len) {
+      sq[k] = subtract(V.data() + lo, V.rows(), cols, c.data(), w.data() + lo, len);
+    });
     h += c;
-    const double after = w.norm();
+    const double after = std::sqrt(sq[0] + sq[1]);
     if (after >= kEta * before) return after;
     before = after;
   }
-  return w.norm();
+  return before;
 }
 
 // V.leftCols(Y.cols()) <- V.leftCols(Y.rows()) Y, in place: by blocks of rows, each of which needs only its own
@@ -50,6 +132,7 @@ LanczosResult thick_restart_lanczos(const std::function<void(const double* x, do
                                     const Eigen::VectorXd& v0, const LanczosOptions& o) {
   LanczosResult out;
   const int m = o.ncv, nev = o.nev;
+  const bool pair = o.pair_vectors;
   const double eps = std::numeric_limits<double>::epsilon();
   const double eps23 = std::pow(eps, 2.0 / 3.0);
   Eigen::MatrixXd V(n, m), T = Eigen::MatrixXd::Zero(m, m);
@@ -90,13 +173,27 @@ LanczosResult thick_restart_lanczos(const std::function<void(const double* x, do
       // the rounding's loss of orthogonality and one pass suffices (DGKS); the first step after a restart couples
       // to every kept vector and goes straight to the full passes.
       h.setZero(j + 1);
-      if (j > k) {
+      double before = -1;
+      if (j > k && !pair) {
         h[j - 1] = T(j, j - 1);
         w.noalias() -= h[j - 1] * V.col(j - 1);
         h[j] = V.col(j).dot(w);
         w.noalias() -= h[j] * V.col(j);
+      } else if (j > k) {
+        h[j - 1] = T(j, j - 1);
+        double dot[2], sq[2];
+        halves(n, [&](int q, Eigen::Index lo, Eigen::Index len) {
+          w.segment(lo, len).noalias() -= h[j - 1] * V.col(j - 1).segment(lo, len);
+          dot[q] = V.col(j).segment(lo, len).dot(w.segment(lo, len));
+        });
+        h[j] = dot[0] + dot[1];
+        halves(n, [&](int q, Eigen::Index lo, Eigen::Index len) {
+          w.segment(lo, len).noalias() -= h[j] * V.col(j).segment(lo, len);
+          sq[q] = w.segment(lo, len).squaredNorm();
+        });
+        before = std::sqrt(sq[0] + sq[1]);
       }
-      const double nrm = orthogonalize(V, j + 1, w, h, true);
+      const double nrm = orthogonalize(V, j + 1, w, h, true, before, pair);
       if (!std::isfinite(nrm) || !h.allFinite()) return out;  // the operator broke down (e.g. a NaN solve)
       T.col(j).head(j + 1) = h;
       T.row(j).head(j + 1) = h.transpose();
@@ -109,8 +206,12 @@ LanczosResult thick_restart_lanczos(const std::function<void(const double* x, do
           active = j + 1;
           break;
         }
-      } else {
+      } else if (!pair) {
         V.col(j + 1) = w / beta;
+      } else {
+        halves(n, [&](int, Eigen::Index lo, Eigen::Index len) {
+          V.col(j + 1).segment(lo, len) = w.segment(lo, len) / beta;
+        });
       }
       T(j + 1, j) = T(j, j + 1) = beta;
     }

@@ -11,6 +11,9 @@ struct LanczosOptions {
   int ncv = 0;  ///< basis size, > nev
   int max_restarts = 500;
   double tolerance = 1e-10;  ///< |beta y_last| <= tolerance max(|theta|, eps^(2/3) theta_max), Spectra's test
+  /// The steps' vector work on two row halves at once (lanczos.cpp): set where the operator's solves run on two
+  /// cores (CholmodFactor::parallel_solves()).
+  bool pair_vectors = false;
 };
 
 struct LanczosResult {

@@ -46,6 +46,9 @@ class CholmodFactor {
   int failed_index() const { return failed_; }
   /// LDL^T only: the number of negative entries of D, i.e. the number of negative eigenvalues of A.
   int negative_pivots() const;
+  /// Whether forward(), backward() and solve() of one right-hand side run on two cores (a simplicial L L^T
+  /// factor: src/internal/tree_solve.hpp); otherwise they are CHOLMOD's own solves.
+  bool parallel_solves() const;
   long long factor_nonzeros() const;
   double factor_flops() const;  ///< floating point operations of the last numeric factorization
   int rows() const { return n_; }
