@@ -27,9 +27,9 @@ void halves(Eigen::Index n, F&& f) {
 }
 
 // c = V^T w over `cols` columns of a row block (V column-major, leading dimension ld; len rows): four columns at a
-// time, so that w is read once per four. AVX2 where the CPU has it (target_clones), plain SSE2 otherwise.
-__attribute__((target_clones("avx2", "default"))) void project(const double* V, Eigen::Index ld, Eigen::Index cols,
-                                                               const double* w, Eigen::Index len, double* c) {
+// time, so that w is read once per four.
+[[gnu::always_inline]] inline void project_body(const double* V, Eigen::Index ld, Eigen::Index cols, const double* w,
+                                                Eigen::Index len, double* c) {
   Eigen::Index j = 0;
   for (; j + 4 <= cols; j += 4) {
     const double *a = V + j * ld, *b = a + ld, *e = b + ld, *d = e + ld;
@@ -51,8 +51,8 @@ __attribute__((target_clones("avx2", "default"))) void project(const double* V, 
 }
 
 // w -= V c over `cols` columns of a row block, four columns at a time; returns ||w||^2 of the block after.
-__attribute__((target_clones("avx2", "default"))) double subtract(const double* V, Eigen::Index ld, Eigen::Index cols,
-                                                                  const double* c, double* w, Eigen::Index len) {
+[[gnu::always_inline]] inline double subtract_body(const double* V, Eigen::Index ld, Eigen::Index cols, const double* c,
+                                                   double* w, Eigen::Index len) {
   Eigen::Index j = 0;
   for (; j + 4 <= cols; j += 4) {
     const double *a = V + j * ld, *b = a + ld, *e = b + ld, *d = e + ld;
@@ -70,6 +70,28 @@ __attribute__((target_clones("avx2", "default"))) double subtract(const double* 
 #pragma omp simd reduction(+ : sq)
   for (Eigen::Index i = 0; i < len; ++i) sq += w[i] * w[i];
   return sq;
+}
+
+// The two kernels compiled for AVX2 and for the baseline x86-64 this project targets, the first where the CPU has
+// it (chosen at run time by a plain test, not an ifunc: a resolver runs before the sanitizers' run-times start).
+[[gnu::target("avx2,fma")]] void project_avx2(const double* V, Eigen::Index ld, Eigen::Index cols, const double* w,
+                                              Eigen::Index len, double* c) {
+  project_body(V, ld, cols, w, len, c);
+}
+[[gnu::target("avx2,fma")]] double subtract_avx2(const double* V, Eigen::Index ld, Eigen::Index cols, const double* c,
+                                                 double* w, Eigen::Index len) {
+  return subtract_body(V, ld, cols, c, w, len);
+}
+bool has_avx2() {
+  static const bool yes = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return yes;
+}
+void project(const double* V, Eigen::Index ld, Eigen::Index cols, const double* w, Eigen::Index len, double* c) {
+  if (has_avx2()) return project_avx2(V, ld, cols, w, len, c);
+  project_body(V, ld, cols, w, len, c);
+}
+double subtract(const double* V, Eigen::Index ld, Eigen::Index cols, const double* c, double* w, Eigen::Index len) {
+  return has_avx2() ? subtract_avx2(V, ld, cols, c, w, len) : subtract_body(V, ld, cols, c, w, len);
 }
 
 // w <- w - V h with h = V^T w over the first `cols` columns, repeated while a pass shrinks w below kEta of its
