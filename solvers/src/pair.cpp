@@ -19,7 +19,8 @@ class Helper {
   Helper(const Helper&) = delete;
   Helper& operator=(const Helper&) = delete;
 
-  bool run(const std::function<void()>& here, const std::function<void()>& there) {
+  // const, with mutable members: its state is its synchronization (one shared helper, never modified from outside).
+  bool run(const std::function<void()>& here, const std::function<void()>& there) const {
     if (getpid() != pid_ || !busy_.try_lock()) return false;
     {
       std::lock_guard<std::mutex> l(m_);
@@ -46,7 +47,7 @@ class Helper {
   }
 
  private:
-  [[noreturn]] void loop() {
+  [[noreturn]] void loop() const {
     std::unique_lock<std::mutex> l(m_);
     for (;;) {
       cv_.wait(l, [&] { return job_ != nullptr; });
@@ -66,11 +67,11 @@ class Helper {
     }
   }
   pid_t pid_;
-  std::mutex m_, busy_;
-  std::condition_variable cv_, done_cv_;
-  const std::function<void()>* job_ = nullptr;
-  std::exception_ptr failed_;
-  bool done_ = false;
+  mutable std::mutex m_, busy_;
+  mutable std::condition_variable cv_, done_cv_;
+  mutable const std::function<void()>* job_ = nullptr;
+  mutable std::exception_ptr failed_;
+  mutable bool done_ = false;
   std::thread thread_;
 };
 
@@ -80,7 +81,7 @@ void run_pair(const std::function<void()>& here, const std::function<void()>& th
   if (!omp_in_parallel() && omp_get_max_threads() > 1) {
     // Started on first use and left running (detached in effect) to the end of the process: it only ever sleeps
     // between calls, and a static destructor joining it could race with other static destructors.
-    static Helper* helper = new Helper;
+    static const Helper* const helper = new Helper;
     if (helper->run(here, there)) return;
   }
   here();

@@ -1,9 +1,9 @@
 #include "internal/tree_solve.hpp"
 
-#include "internal/pair.hpp"
-
 #include <Eigen/Core>
 #include <algorithm>
+
+#include "internal/pair.hpp"
 
 namespace dynid::detail {
 
@@ -18,7 +18,8 @@ constexpr double kBalance = 1.03;
 // Largest-first packing of the candidates into kBins sets: the set of each candidate, and the largest load.
 double pack(const std::vector<int>& cands, const std::vector<double>& W, std::vector<int>* bin_of) {
   std::vector<int> order(cands);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return W[static_cast<std::size_t>(a)] > W[static_cast<std::size_t>(b)]; });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return W[static_cast<std::size_t>(a)] > W[static_cast<std::size_t>(b)]; });
   double load[TreeSolve::kBins] = {};
   for (int c : order) {
     int b = 0;
@@ -54,10 +55,12 @@ std::vector<int> split_tree(const std::vector<int>& parent, const std::vector<do
     double sum = 0;
     for (int c : cands) sum += W[static_cast<std::size_t>(c)];
     const double largest = pack(cands, W, nullptr);
-    if (best_cost < 0 || largest + top_work < best_cost) best_cost = largest + top_work, best_cands = cands, best_top = top;
+    if (best_cost < 0 || largest + top_work < best_cost)
+      best_cost = largest + top_work, best_cands = cands, best_top = top;
     if (largest <= kBalance * sum / TreeSolve::kBins || top_work > 0.5 * total || cands.empty()) break;
-    auto h = std::max_element(cands.begin(), cands.end(),
-                              [&](int a, int b) { return W[static_cast<std::size_t>(a)] < W[static_cast<std::size_t>(b)]; });
+    auto h = std::max_element(cands.begin(), cands.end(), [&](int a, int b) {
+      return W[static_cast<std::size_t>(a)] < W[static_cast<std::size_t>(b)];
+    });
     const int node = *h;
     cands.erase(h);
     top.push_back(node);
@@ -69,7 +72,8 @@ std::vector<int> split_tree(const std::vector<int>& parent, const std::vector<do
   for (int c : best_cands) bin[static_cast<std::size_t>(c)] = bin_of[static_cast<std::size_t>(c)];
   for (int t : best_top) bin[static_cast<std::size_t>(t)] = -1;
   for (int k = N - 1; k >= 0; --k)  // from each candidate down its subtree
-    if (bin[static_cast<std::size_t>(k)] == -2) bin[static_cast<std::size_t>(k)] = bin[static_cast<std::size_t>(parent[static_cast<std::size_t>(k)])];
+    if (bin[static_cast<std::size_t>(k)] == -2)
+      bin[static_cast<std::size_t>(k)] = bin[static_cast<std::size_t>(parent[static_cast<std::size_t>(k)])];
   return bin;
 }
 
@@ -160,8 +164,8 @@ namespace {
 // Forward over one chain of G simplicial columns j .. j + G - 1: column j + m holds row j + q (q >= m) at its
 // position q - m, and the rows below the chain (column j's positions G ..) at position k - m.
 template <int G>
-void forward_chain(int j, const int* p, const int* nz, const int* rows, const double* vals, int split,
-                   const int* slot, double* x, double* acc) {
+void forward_chain(int j, const int* p, const int* nz, const int* rows, const double* vals, int split, const int* slot,
+                   double* x, double* acc) {
   const double* V[G];
   for (int m = 0; m < G; ++m) V[m] = vals + p[j + m];
   double y[G];
@@ -209,10 +213,18 @@ void TreeSolve::forward_columns(int lo, int hi, double* x, double* acc) const {
     const int g = group_[static_cast<std::size_t>(j)];
     const int split = split_[static_cast<std::size_t>(j)];
     switch (g) {
-      case 4: forward_chain<4>(j, p_, nz_, i_, x_, split, slot, x, acc); break;
-      case 3: forward_chain<3>(j, p_, nz_, i_, x_, split, slot, x, acc); break;
-      case 2: forward_chain<2>(j, p_, nz_, i_, x_, split, slot, x, acc); break;
-      default: forward_chain<1>(j, p_, nz_, i_, x_, split, slot, x, acc); break;
+      case 4:
+        forward_chain<4>(j, p_, nz_, i_, x_, split, slot, x, acc);
+        break;
+      case 3:
+        forward_chain<3>(j, p_, nz_, i_, x_, split, slot, x, acc);
+        break;
+      case 2:
+        forward_chain<2>(j, p_, nz_, i_, x_, split, slot, x, acc);
+        break;
+      default:
+        forward_chain<1>(j, p_, nz_, i_, x_, split, slot, x, acc);
+        break;
     }
     j += std::max(g, 1);
   }
@@ -224,10 +236,18 @@ void TreeSolve::backward_columns(int lo, int hi, double* x) const {
     int first = j;
     while (group_[static_cast<std::size_t>(first)] == 0) --first;
     switch (group_[static_cast<std::size_t>(first)]) {
-      case 4: backward_chain<4>(first, p_, nz_, i_, x_, x); break;
-      case 3: backward_chain<3>(first, p_, nz_, i_, x_, x); break;
-      case 2: backward_chain<2>(first, p_, nz_, i_, x_, x); break;
-      default: backward_chain<1>(first, p_, nz_, i_, x_, x); break;
+      case 4:
+        backward_chain<4>(first, p_, nz_, i_, x_, x);
+        break;
+      case 3:
+        backward_chain<3>(first, p_, nz_, i_, x_, x);
+        break;
+      case 2:
+        backward_chain<2>(first, p_, nz_, i_, x_, x);
+        break;
+      default:
+        backward_chain<1>(first, p_, nz_, i_, x_, x);
+        break;
     }
     j = first - 1;
   }
@@ -237,7 +257,8 @@ void TreeSolve::forward(double* x) const {
   const std::size_t tc = static_cast<std::size_t>(top_cols_);
   std::vector<double> acc(kBins * tc, 0.0);
   run_sets([&](int b) {
-    for (const auto& [lo, hi] : bin_ranges_[static_cast<std::size_t>(b)]) forward_columns(lo, hi, x, acc.data() + static_cast<std::size_t>(b) * tc);
+    for (const auto& [lo, hi] : bin_ranges_[static_cast<std::size_t>(b)])
+      forward_columns(lo, hi, x, acc.data() + static_cast<std::size_t>(b) * tc);
   });
   // The sets' updates of the top rows, in a fixed order, then the top.
   for (std::size_t s = 0; s < tc; ++s)
