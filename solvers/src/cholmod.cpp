@@ -74,6 +74,7 @@ void CholmodFactor::analyze(const SparseMatrix& A) {
   if (A.rows() != A.cols()) throw InputError("CholmodFactor: matrix is not square");
   if (!A.isCompressed()) throw InputError("CholmodFactor: matrix must be compressed");
   cholmod_common& c = impl_->c;
+  impl_->tree = detail::TreeSolve();  // it points into the factor freed here
   if (impl_->L) cholmod_free_factor(&impl_->L, &c);
   n_ = static_cast<int>(A.rows());
   cholmod_sparse s = view(A);
@@ -89,12 +90,12 @@ bool CholmodFactor::factorize(const SparseMatrix& A) {
   cholmod_common& c = impl_->c;
   cholmod_sparse s = view(A);
   failed_ = -1;
+  impl_->tree = detail::TreeSolve();  // it points into the factor's arrays, which the factorization may replace
   const int ok = cholmod_factorize(&s, impl_->L, &c);
   if (!ok && c.status != CHOLMOD_NOT_POSDEF)
     throw NumericalError("CHOLMOD factorization failed (status " + std::to_string(c.status) +
                          (c.status == CHOLMOD_OUT_OF_MEMORY ? ": out of memory" : "") + ")");
   cholmod_factor* L = impl_->L;
-  impl_->tree = detail::TreeSolve();
   if (c.status == CHOLMOD_NOT_POSDEF || L->minor < L->n) {
     const size_t k = std::min<size_t>(L->minor, L->n - 1);
     failed_ = L->Perm ? static_cast<int*>(L->Perm)[k] : static_cast<int>(k);
