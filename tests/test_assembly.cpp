@@ -1,7 +1,5 @@
 // Sparse assembly: equal to a straightforward dense assembly, symmetric, and bitwise identical for any number
 // of threads.
-#include <omp.h>
-
 #include <cstring>
 
 #include "dynid/engine/modal.hpp"
@@ -55,12 +53,7 @@ TEST(Assembly, MatchesDenseAssembly) {
 
 TEST(Assembly, BitwiseIdenticalForOneAndTwoThreads) {
   const Model m = make_frame3d(Small3D());
-  const int saved = omp_get_max_threads();
-  omp_set_num_threads(1);
-  const AssembledSystem a = assemble_system(m);
-  omp_set_num_threads(2);
-  const AssembledSystem b = assemble_system(m);
-  omp_set_num_threads(saved);
+  const auto [a, b] = test::OnOneThreadAndTwo([&] { return assemble_system(m); });
   ASSERT_EQ(a.K.nonZeros(), b.K.nonZeros());
   EXPECT_EQ(0, std::memcmp(a.K.valuePtr(), b.K.valuePtr(), sizeof(double) * a.K.nonZeros()));
   EXPECT_EQ(0, std::memcmp(a.M.valuePtr(), b.M.valuePtr(), sizeof(double) * a.M.nonZeros()));

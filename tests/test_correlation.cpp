@@ -1,6 +1,4 @@
 // Correlation and reduction kernels against independent computations.
-#include <omp.h>
-
 #include <Eigen/Dense>
 #include <cstring>
 
@@ -121,11 +119,11 @@ TEST(ResidualForces, ParallelKernelMatchesDenseAndIsDeterministic) {
   const AssembledSystem s = assemble_system(c.model);
   const Eigen::MatrixXd Phi = Eigen::MatrixXd::Random(s.K.rows(), 7);
   const Eigen::VectorXd lam = Eigen::VectorXd::LinSpaced(7, 10, 1000);
-  Eigen::MatrixXd R1, R2;
-  omp_set_num_threads(1);
-  residual_forces(s.K, s.M, Phi, lam, &R1);
-  omp_set_num_threads(2);
-  residual_forces(s.K, s.M, Phi, lam, &R2);
+  const auto [R1, R2] = test::OnOneThreadAndTwo([&] {
+    Eigen::MatrixXd R;
+    residual_forces(s.K, s.M, Phi, lam, &R);
+    return R;
+  });
   EXPECT_EQ(0, std::memcmp(R1.data(), R2.data(), sizeof(double) * R1.size()));
   const Eigen::MatrixXd ref = -(test::Dense(s.K) * Phi) + test::Dense(s.M) * Phi * lam.asDiagonal();
   EXPECT_LT((R1 - ref).cwiseAbs().maxCoeff(), 1e-12 * ref.cwiseAbs().maxCoeff());

@@ -1,7 +1,5 @@
 // Eigen-solvers: the sparse shift-invert Lanczos path against the dense path (1e-8 relative) on every model
 // small enough for the dense path; free-free structures, singular mass matrices, band mode, mechanisms.
-#include <omp.h>
-
 #include <Eigen/Dense>
 #include <random>
 
@@ -195,24 +193,20 @@ TEST(Eigen, TwoCoreSimplicialSolvesMatchCholmodForAnyThreadCount) {
   std::uniform_real_distribution<double> u(-1, 1);
   Eigen::VectorXd b(n);
   for (Eigen::Index i = 0; i < n; ++i) b[i] = u(rng);
-  const int saved = omp_get_max_threads();
-  Eigen::VectorXd x[2];
-  for (int threads : {1, 2}) {
-    omp_set_num_threads(threads);
-    Eigen::VectorXd& xt = x[threads - 1];
-    xt.resize(n);
+  const auto [x1, x] = test::OnOneThreadAndTwo([&] {
+    Eigen::VectorXd xt(n);
     F.forward(b.data(), xt.data());
     F.backward(xt.data(), xt.data());
-  }
-  omp_set_num_threads(saved);
-  EXPECT_EQ((x[0] - x[1]).cwiseAbs().maxCoeff(), 0.0);
+    return xt;
+  });
+  EXPECT_EQ((x1 - x).cwiseAbs().maxCoeff(), 0.0);
   Eigen::MatrixXd ref;
   F.solve_block(b, &ref);
-  EXPECT_LT((x[1] - ref.col(0)).norm(), 1e-12 * ref.norm());
-  EXPECT_LT((sys.K.selfadjointView<Eigen::Upper>() * x[1] - b).norm(), 1e-8 * b.norm());
+  EXPECT_LT((x - ref.col(0)).norm(), 1e-12 * ref.norm());
+  EXPECT_LT((sys.K.selfadjointView<Eigen::Upper>() * x - b).norm(), 1e-8 * b.norm());
   Eigen::VectorXd y(n);
   F.solve(b.data(), y.data());
-  EXPECT_EQ((y - x[1]).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ((y - x).cwiseAbs().maxCoeff(), 0.0);
 
   const Model small = make_frame2d(Frame2D(20, 20, 4)), supernodal = make_frame3d(test::SteelFrame3D(16, 16, 16));
   ASSERT_LT(small.num_dofs(), 20000);
@@ -240,18 +234,14 @@ TEST(Lanczos, SameRitzPairsOnOneThreadAndTwo) {
   std::uniform_real_distribution<double> u(-1, 1);
   Eigen::VectorXd v0(n);
   for (Eigen::Index i = 0; i < n; ++i) v0[i] = u(rng);
-  const int saved = omp_get_max_threads();
-  detail::LanczosResult r[2];
-  for (int threads : {1, 2}) {
-    omp_set_num_threads(threads);
-    r[threads - 1] = detail::thick_restart_lanczos(diag, n, v0, detail::LanczosOptions{6, 20, 200, 1e-10, true});
-  }
-  omp_set_num_threads(saved);
-  ASSERT_TRUE(r[0].converged);
-  ASSERT_TRUE(r[1].converged);
-  EXPECT_EQ((r[0].theta - r[1].theta).cwiseAbs().maxCoeff(), 0.0);
-  EXPECT_EQ((r[0].Y - r[1].Y).cwiseAbs().maxCoeff(), 0.0);
-  for (Eigen::Index i = 0; i < 6; ++i) EXPECT_NEAR(r[1].theta[i], d[i], 1e-10 * d[i]) << i;
+  const auto [one, two] = test::OnOneThreadAndTwo([&] {
+    return detail::thick_restart_lanczos(diag, n, v0, detail::LanczosOptions{6, 20, 200, 1e-10, true});
+  });
+  ASSERT_TRUE(one.converged);
+  ASSERT_TRUE(two.converged);
+  EXPECT_EQ((one.theta - two.theta).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ((one.Y - two.Y).cwiseAbs().maxCoeff(), 0.0);
+  for (Eigen::Index i = 0; i < 6; ++i) EXPECT_NEAR(two.theta[i], d[i], 1e-10 * d[i]) << i;
 }
 
 // The thick-restart Lanczos on operators whose answer is known. A diagonal operator with 5 distinct values,

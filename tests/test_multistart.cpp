@@ -3,7 +3,6 @@
 // same weights given another way), central differences of the residuals (the analytic Jacobian), and the search
 // run with another thread count (must give identical numbers).
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <cmath>
 #include <filesystem>
@@ -120,12 +119,8 @@ TEST(Multistart, SameResultForAnyThreadCountAndTheBestIsNoWorse) {
   Problem s("smu-eighteen-story");
   const UpdateSpec& u = *s.c.update;
   MultiStartOptions ms;
-  const int threads = omp_get_max_threads();
-  omp_set_num_threads(1);
-  const MultiStartSummary one = fit_multistart(*s.pm, s.measured, u.initial, u.free, u.options, ms);
-  omp_set_num_threads(2);
-  const MultiStartSummary two = fit_multistart(*s.pm, s.measured, u.initial, u.free, u.options, ms);
-  omp_set_num_threads(threads);
+  const auto [one, two] =
+      test::OnOneThreadAndTwo([&] { return fit_multistart(*s.pm, s.measured, u.initial, u.free, u.options, ms); });
   ASSERT_EQ(one.start_points.size(), static_cast<std::size_t>(starts_for(6)));
   EXPECT_EQ(starts_for(6), 12);
   EXPECT_EQ(one.start_cost, two.start_cost);

@@ -2,11 +2,13 @@
 #pragma once
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <Eigen/Core>
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <utility>
 
 #include "dynid/engine/identify.hpp"
 #include "dynid/mesh/error.hpp"
@@ -95,6 +97,19 @@ namespace dynid::test {
 
 /// Dense copy of a sparse matrix.
 inline Eigen::MatrixXd Dense(const SparseMatrix& A) { return Eigen::MatrixXd(A); }
+
+/// f() with one OpenMP thread, then with two (the caller's thread count restored): {one, two}, for the tests that a
+/// result does not depend on the thread count.
+template <class F>
+auto OnOneThreadAndTwo(F&& f) {
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(1);
+  auto one = f();
+  omp_set_num_threads(2);
+  auto two = f();
+  omp_set_num_threads(saved);
+  return std::make_pair(std::move(one), std::move(two));
+}
 
 /// A steel 3D frame without symmetry in plan (spans 5 m x 4 m, storeys 3 m, members in 2 elements): simple
 /// eigenvalues.
