@@ -19,7 +19,7 @@ struct CholmodFactor::Impl {
   mutable cholmod_dense* Y = nullptr;
   mutable cholmod_dense* E = nullptr;
   detail::TreeSolve tree;           // simplicial L L^T solves of one right-hand side on two cores (tree_solve.hpp)
-  mutable Eigen::VectorXd scratch;  // the permuted right-hand side of those solves
+  mutable Eigen::VectorXd scratch;  // a copy of the right-hand side of those solves, for the permutations
   Impl() { cholmod_start(&c); }
   ~Impl() {
     if (L) cholmod_free_factor(&L, &c);
@@ -136,13 +136,14 @@ void CholmodFactor::forward(const double* b, double* x) const {
     solve_sys(CHOLMOD_L, x, x);
     return;
   }
-  // x = L^{-1} P b: (P b)[k] = b[Perm[k]] (b and x may alias).
+  // x = L^{-1} P b: (P b)[k] = b[Perm[k]], gathered into x and solved there (b copied first where it is x).
   const int* perm = static_cast<const int*>(impl_->L->Perm);
-  Eigen::VectorXd& y = impl_->scratch;
-  y.resize(n_);
-  for (int k = 0; k < n_; ++k) y[k] = b[perm ? perm[k] : k];
-  impl_->tree.forward(y.data());
-  std::copy(y.data(), y.data() + n_, x);
+  if (b == x) {
+    impl_->scratch = Eigen::Map<const Eigen::VectorXd>(b, n_);
+    b = impl_->scratch.data();
+  }
+  for (int k = 0; k < n_; ++k) x[k] = b[perm ? perm[k] : k];
+  impl_->tree.forward(x);
 }
 
 void CholmodFactor::backward(const double* b, double* x) const {
