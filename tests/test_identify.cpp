@@ -335,6 +335,42 @@ TEST(VirtualTest, WideBandCantileverLowestModesWithTheDefaultBandRule) {
   expect_identified(t.modes, s, 0, 1.01 * t.modes.frequencies_hz[1], kFreqTol, 0.3, kMinMac);
 }
 
+// Issue 16: impacts plan their band from the outputs' |FRF|^2, whose 10th percentile is no noise floor: the |FRF|^2
+// of accelerations falls to nothing below the first mode and rises where the hits are weak. A simply supported
+// strip hit next to a support (where its first mode moves least) at 3 % damping and 4 % noise: its first mode
+// stood 16 dB above its surroundings but within 10 dB of that percentile, the band started at half the second
+// mode, and the first was lost (two such tests in 100 impact tests of the identification benchmark). The
+// outputs' own energy shows it far above the sensors' noise: it is in the band and identified.
+TEST(VirtualTest, ImpactNearASupportKeepsTheFirstModeInTheBand) {
+  BeamSpec b;
+  b.length = 1.5;
+  b.elements = 30;
+  b.material.E = 210e9;
+  b.material.rho = 7850;
+  b.section.A = 0.05 * 0.01;
+  b.section.Iz = 0.05 * 1e-6 / 12;
+  b.section.Iy = 0.01 * 1.25e-4 / 12;
+  b.section.J = b.section.Iy + b.section.Iz;
+  b.support = BeamSupport::SimplySupported;
+  const Model m = make_beam(b);
+  const ModalResult modes = all_modes(m);
+  const double f1 = modes.frequencies_hz[0];
+  ASSERT_GT(f1, 5);
+  Opt o = plan(m, Opt::Excitation::kImpact, 1024, 4.6 / (0.03 * 2 * 3.14159265358979 * f1), 40 * f1);
+  o.damping_ratio = 0.03;
+  o.noise = o.force_noise = 0.04;
+  o.sensors.clear();
+  for (const MeasuredDof& d : dofs_of_types(m, kTranslations))
+    if (d.dof == Dof::UY && d.node % 2 == 0) o.sensors.push_back(d);
+  o.inputs = {{2, Dof::UY}};
+  o.impacts = 5;
+  const VirtualTest t = simulate_test(m, modes, o);
+  const IdentificationSummary s = identify_recordings(t.recordings, "", IdentificationOptions{});
+  std::printf("  band %.4g-%.4g Hz (f1 %.4g Hz), lines %.4g Hz\n", s.band_lo_hz, s.band_hi_hz, f1, s.resolution_hz);
+  EXPECT_LT(s.band_lo_hz, f1);
+  expect_identified(t.modes, s, 0, 1.01 * t.modes.frequencies_hz[1], kFreqTol, 0.3, kMinMac);
+}
+
 // Two clusters with one shape: the mode indicator's power response |H|^2 of 1 % damped modes on lines 0.0005
 // apart, and two candidates at 1 and 1.04 (4 % apart: beyond the half-power merge window max(3 %, zeta)).
 struct SplitPair {

@@ -89,8 +89,11 @@ double half_power_width(const Spectrum& sp, double f) {
 }
 
 // Peaks of a spectrum (power-like levels) that stand >= 10 dB above their surroundings and above the 10th
-// percentile of the levels up to `top`, ascending.
-std::vector<double> band_peaks(const Spectrum& q, double top, std::vector<double>* widths);
+// percentile of the levels up to `top`, ascending. Impacts pass the outputs' own energy spectrum as `outputs`
+// (q is then their |FRF|^2): a peak also counts where the outputs' energy stands 10 dB above its own 10th
+// percentile (see plan_identification).
+std::vector<double> band_peaks(const Spectrum& q, double top, std::vector<double>* widths,
+                               const Spectrum* outputs = nullptr);
 
 // The band rule (identify.hpp): [0.5 x lowest peak, min(1.25 x highest, top)].
 void band_from_peaks(IdentificationPlan& p, double top) {
@@ -109,16 +112,34 @@ void band_from_peaks(IdentificationPlan& p, double top) {
   p.notes.push_back(b);
 }
 
-std::vector<double> band_peaks(const Spectrum& q, double top, std::vector<double>* widths) {
-  Eigen::VectorXd db(q.level.size());
-  for (Eigen::Index k = 0; k < db.size(); ++k) db[k] = 10 * std::log10(std::max(q.level[k], 1e-300));
-  std::vector<double> in_band;
-  for (Eigen::Index k = 1; k < db.size(); ++k)
-    if (q.f[k] <= top) in_band.push_back(db[k]);
-  const double floor = percentile(in_band, 0.1);
+std::vector<double> band_peaks(const Spectrum& q, double top, std::vector<double>* widths, const Spectrum* outputs) {
+  auto decibels = [](const Eigen::VectorXd& level) {
+    Eigen::VectorXd db(level.size());
+    for (Eigen::Index k = 0; k < db.size(); ++k) db[k] = 10 * std::log10(std::max(level[k], 1e-300));
+    return db;
+  };
+  // The 10th percentile of a spectrum's levels (dB) up to top: its floor.
+  auto floor_of = [&](const Spectrum& x, const Eigen::VectorXd& db) {
+    std::vector<double> in_band;
+    for (Eigen::Index k = 1; k < db.size(); ++k)
+      if (x.f[k] <= top) in_band.push_back(db[k]);
+    return percentile(in_band, 0.1);
+  };
+  const Eigen::VectorXd db = decibels(q.level);
+  const double floor = floor_of(q, db);
+  const bool own = outputs && outputs->level.size() == q.level.size();
+  const Eigen::VectorXd out_db = own ? decibels(outputs->level) : Eigen::VectorXd();
+  const double out_floor = own ? floor_of(*outputs, out_db) : 0;
   std::vector<double> out;
-  for (const SpectrumPeak& pk : spectrum_peaks(q.f, db, q.f[0] + q.df * 0.5, top, 10.0))
-    if (pk.level_db >= floor + 10) out.push_back(pk.frequency_hz);
+  for (const SpectrumPeak& pk : spectrum_peaks(q.f, db, q.f[0] + q.df * 0.5, top, 10.0)) {
+    bool above = pk.level_db >= floor + 10;
+    if (!above && own) {  // the outputs' energy on the lines either side of the peak
+      const Eigen::Index k =
+          std::clamp<Eigen::Index>(static_cast<Eigen::Index>(pk.frequency_hz / q.df), 0, out_db.size() - 2);
+      above = std::max(out_db[k], out_db[k + 1]) >= out_floor + 10;
+    }
+    if (above) out.push_back(pk.frequency_hz);
+  }
   std::sort(out.begin(), out.end());
   if (widths) {
     widths->clear();
@@ -185,8 +206,10 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
   int segment = p.impulsive ? 0 : pow2_at_most(static_cast<double>(shortest) / 8);
   if (!p.impulsive && segment < 64) segment = pow2_at_most(static_cast<double>(shortest));
   Spectrum sp = channel_spectrum(recs, p.impulsive, segment, false);
-  Spectrum hits;  // impacts: the hits' energy spectrum
+  Spectrum hits;    // impacts: the hits' energy spectrum
+  Spectrum energy;  // impacts: the outputs' own energy spectrum, before it is divided by the hits'
   if (p.impulsive) {
+    energy = sp;
     // Impacts: the outputs' energy over the hits' (a sum of |FRF|^2): the peaks of every mode the hits excite,
     // not only of those below the hits' spectral roll-off.
     hits = channel_spectrum(recs, true, segment, true);
@@ -201,7 +224,13 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
     p.segment = o.segment > 0 ? o.segment : 0;
     return p;
   }
-  auto peaks_of = [&](const Spectrum& q, std::vector<double>* widths) { return band_peaks(q, 0.45 * fs, widths); };
+  // Impacts: the |FRF|^2 of accelerations falls to nothing below the lowest mode and rises where the hits are
+  // weak, so its 10th percentile can stand within 10 dB of a well-excited lowest mode; the outputs' energy, whose
+  // floor is the sensors' noise, shows that mode (a simply supported beam hit near a support: its first mode 16 dB
+  // above its own floor, 8 dB above the |FRF|^2's).
+  auto peaks_of = [&](const Spectrum& q, std::vector<double>* widths) {
+    return band_peaks(q, 0.45 * fs, widths, p.impulsive ? &energy : nullptr);
+  };
   std::vector<double> widths;
   p.peaks_hz = peaks_of(sp, &widths);
   // Resolution: refine continuous records while the lowest peak's half-power width spans < 4 lines.

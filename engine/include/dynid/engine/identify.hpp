@@ -237,7 +237,9 @@ constexpr double kResolvedLines = 4;
 /// hits' spectral roll-off show their peaks too).
 ///   band: [0.5 x lowest peak, min(1.25 x highest peak, 0.45 x sampling rate)], over the peaks that stand
 ///         >= 10 dB above their surroundings (prominence) and >= 10 dB above the spectrum's 10th-percentile
-///         level (the noise floor); the whole range below 0.45 fs when there is none. Records with a measured
+///         level (the noise floor; impacts: or the outputs' own energy >= 10 dB above its 10th percentile, since
+///         the |FRF|^2 of accelerations has no such floor: it falls to nothing below the first mode and rises
+///         where the hits are weak); the whole range below 0.45 fs when there is none. Records with a measured
 ///         force (continuous or hits): the top reaches where the force's spectrum ends (the highest line within
 ///         10 dB of its median level), when the peaks' rule stops below it (the highest modes' peaks stand out
 ///         less, or overlap).
