@@ -148,14 +148,14 @@ std::vector<double> band_peaks(const Spectrum& q, double top, std::vector<double
   return out;
 }
 
-// The highest frequency up to `top` where a force spectrum stands within 10 dB of its median level over
+// The highest frequency up to `top` where a force spectrum stands within 20 dB of its median level over
 // (0, top]: the end of a broadband excitation. 0 when there is no spectrum.
 double excitation_top(const Spectrum& q, double top) {
   std::vector<double> levels;
   for (Eigen::Index k = 1; k < q.level.size(); ++k)
     if (q.f[k] <= top) levels.push_back(q.level[k]);
   if (levels.empty()) return 0;
-  const double floor = 0.1 * percentile(levels, 0.5);
+  const double floor = 0.01 * percentile(levels, 0.5);
   double edge = 0;
   for (Eigen::Index k = 1; k < q.level.size(); ++k)
     if (q.f[k] <= top && q.level[k] >= floor) edge = q.f[k];
@@ -259,7 +259,7 @@ IdentificationPlan plan_identification(const std::vector<Recording>& recs, const
         p.band_hi_hz = edge;
         char b[160];
         std::snprintf(b, sizeof b,
-                      "band top %.4g Hz: where the measured force's spectrum ends (10 dB below its median)", edge);
+                      "band top %.4g Hz: where the measured force's spectrum ends (20 dB below its median)", edge);
         p.notes.push_back(b);
       }
     } else if (!p.impulsive && p.band_from_data) {
