@@ -241,9 +241,9 @@ constexpr double kResolvedLines = 4;
 ///         the |FRF|^2 of accelerations has no such floor: it falls to nothing below the first mode and rises
 ///         where the hits are weak); the whole range below 0.45 fs when there is none. Records with a measured
 ///         force (continuous or hits): the top reaches where the force's spectrum ends (the highest line within
-///         20 dB of its median level: a mode where the force puts a hundredth of its median power still stands out
-///         of the |FRF|^2, whose peaks the rule takes above the roll-off too), when the peaks' rule stops below it (the
-///         highest modes' peaks stand out less, or overlap).
+///         20 dB of its median level: a mode where the force puts a hundredth of its median power still stands
+///         out of the |FRF|^2), when the peaks' rule stops below it (the highest modes' peaks stand out less, or
+///         overlap).
 ///   resolution (continuous records): the lowest peak's half-power bandwidth 2 zeta f (zeta from the -3 dB
 ///         width, refined with longer segments while the width spans fewer than kResolvedLines = 4 lines) spans
 ///         4 lines: segment = fs / (zeta f / 2), a power of two, at most a quarter of the shortest record (>= 7
