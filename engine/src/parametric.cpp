@@ -402,4 +402,59 @@ void ParametricModel::derivative_products(int p, const Eigen::VectorXd& theta, c
   }
 }
 
+void ParametricModel::projected_derivatives(int p, const Eigen::VectorXd& theta, const RowMatrix& V,
+                                            Eigen::MatrixXd* dK, Eigen::MatrixXd* dM) const {
+  build();
+  const Eigen::Index r = V.cols();
+  // Stacked over the parameter's terms: G holds V's rows at each term's free DOFs, H the rows of dA V there, so
+  // that V^T dA V = G^T H (one product per matrix).
+  RowMatrix G[2] = {RowMatrix(0, r), RowMatrix(0, r)}, H[2] = {RowMatrix(0, r), RowMatrix(0, r)};
+  Eigen::Index used[2] = {0, 0};
+  auto reserve = [&](int which, Eigen::Index rows) {
+    if (G[which].rows() < used[which] + rows) {
+      const Eigen::Index want = std::max<Eigen::Index>(2 * G[which].rows(), used[which] + rows);
+      G[which].conservativeResize(want, r);
+      H[which].conservativeResize(want, r);
+    }
+  };
+  RowMatrix Ve, Y;
+  auto add = [&](int which, const std::vector<int>& dofs, const Eigen::MatrixXd& A, double ds) {
+    const int nd = static_cast<int>(dofs.size());
+    Ve.setZero(nd, r);
+    for (int a = 0; a < nd; ++a)
+      if (dofs[a] >= 0) Ve.row(a) = V.row(dofs[a]);
+    Y.noalias() = ds * A * Ve;
+    reserve(which, nd);
+    for (int a = 0; a < nd; ++a) {
+      if (dofs[a] < 0) continue;
+      G[which].row(used[which]) = Ve.row(a);
+      H[which].row(used[which]) = Y.row(a);
+      ++used[which];
+    }
+  };
+  Eigen::MatrixXd A;
+  for (int k : terms_of_param_[p]) {
+    const Term& t = terms_[k];
+    const double ds = dscale(t, p, theta);
+    if (t.sparse) {
+      A.setZero(static_cast<Eigen::Index>(t.dofs.size()), static_cast<Eigen::Index>(t.dofs.size()));
+      for (std::size_t e = 0; e < t.ev.size(); ++e) A(t.ea[e], t.eb[e]) += t.ev[e];
+      add(t.mass ? 1 : 0, t.dofs, A, ds);
+    } else {
+      add(t.mass ? 1 : 0, t.dofs, t.A, ds);
+    }
+  }
+  Eigen::MatrixXd cK, cM;
+  for (int k : custom_of_param_[p]) {
+    custom_derivative(k, p, theta, &cK, &cM);
+    add(0, custom_[k].term.dofs, cK, 1.0);
+    add(1, custom_[k].term.dofs, cM, 1.0);
+  }
+  Eigen::MatrixXd* out[2] = {dK, dM};
+  for (int which = 0; which < 2; ++which) {
+    const Eigen::Index u = used[which];
+    *out[which] = G[which].topRows(u).transpose() * H[which].topRows(u);
+  }
+}
+
 }  // namespace dynid

@@ -60,6 +60,16 @@ struct FitOptions {
   /// parameters (discovery's screening) the sparse path is the cheaper one well below 400 DOFs.
   int dense_max_dofs = 400;
   bool covariance = true;
+  /// Reduced-basis fit (large models): each outer step solves the full model once (modes, Jacobian), projects it
+  /// on its modes and one block of shift-invert Krylov vectors (V^T K(theta) V, V^T M(theta) V, linear in the
+  /// parameters about that point), corrects the projection to the full residuals and Jacobian there (first-order
+  /// consistent), and minimises that surrogate within a trust region; the full model then accepts or rejects the
+  /// step. Same minimum as the direct fit, far fewer eigen-solves. kAuto: on for sparse models of at least
+  /// reduced_basis_min_dofs DOFs. Not applied (a warning says so) to the f2 objective, to models solved densely
+  /// and to free-free models.
+  enum class ReducedBasis { kOff, kAuto, kOn };
+  ReducedBasis reduced_basis = ReducedBasis::kOff;
+  int reduced_basis_min_dofs = 20000;
   /// Tied parameters: theta[p] = ratio * theta[q] for each (p, (q, ratio)); q must be free, p is not.
   std::vector<std::pair<int, std::pair<int, double>>> ties;
   bool IsValid(std::string* why) const;
@@ -72,10 +82,14 @@ struct FitSummary {
   int covariance_rank = 0;      ///< rank of J^T J over the free parameters
   int free_parameters = 0;
   std::vector<double> cost_history;  ///< Ceres cost (1/2 sum r^2) per iteration, starting with the initial
-  int iterations = 0;
+  int iterations = 0;                ///< Ceres iterations, or the reduced-basis fit's outer steps taken
+  int rejected_steps = 0;            ///< reduced-basis fit: outer steps the full model rejected
+  int surrogate_iterations = 0;      ///< reduced-basis fit: Ceres iterations on the surrogates (no eigen-solve)
+  bool reduced_basis = false;        ///< the fit ran on reduced-basis surrogates
   int evaluations = 0;          ///< model evaluations (eigen-solves)
   double time_eigen = 0;        ///< seconds in eigen-solves
   double time_sensitivity = 0;  ///< seconds in sensitivities (Jacobians)
+  double time_surrogate = 0;    ///< reduced-basis fit: seconds building and minimising the surrogates
   double time_total = 0;        ///< seconds in fit_parameters
   std::string termination;      ///< Ceres termination: CONVERGENCE, NO_CONVERGENCE, FAILURE, ...
   bool converged = false;

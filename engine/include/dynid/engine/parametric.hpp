@@ -86,6 +86,12 @@ class ParametricModel {
   };
   void derivative_products(int p, const Eigen::VectorXd& theta, const Eigen::VectorXd& v, SparseProducts* out) const;
 
+  /// V^T (dK/dtheta_p) V and V^T (dM/dtheta_p) V (r x r) for a basis V (n x r, row-major so that a DOF's row
+  /// is contiguous): the parameter's derivative projected on V, from element matrices.
+  using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  void projected_derivatives(int p, const Eigen::VectorXd& theta, const RowMatrix& V, Eigen::MatrixXd* dK,
+                             Eigen::MatrixXd* dM) const;
+
   const Model& model() const { return model_; }
   const SparseMatrix& K0() const { return K0_; }
   const SparseMatrix& M0() const { return M0_; }
