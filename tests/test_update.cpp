@@ -270,6 +270,25 @@ TEST(Update, ReducedBasisOnlyWhereItApplies) {
   EXPECT_TRUE(HasWarning(s, "the reduced-basis fit does not apply here"));
 }
 
+TEST(Update, ReducedBasisFromTheCaseFile) {
+  // reduced_basis: off | on | auto; anything else names the key and the choices. On the SMU frame (solved
+  // densely) `on` runs the direct fit and says why.
+  const test::ScratchDir dir{"rb"};
+  const std::string frame = test::CasesDir() + "/smu-four-story/";
+  auto text = [&](const std::string& v) {
+    return "name: t\nmodel: {include: " + frame + "model.yaml}\nupdate:\n  measured: " + frame +
+           "measured.json\n  objective: combined\n  reduced_basis: " + v +
+           "\n  parameters:\n    - {name: k, factor: E, each: [1, 2, 3, 4], bounds: [0.2, 5.0]}\n";
+  };
+  EXPECT_HAS(test::ErrorOf([&] { load_case(dir.write("bad.yaml", text("fast"))); }),
+             "reduced_basis must be off, on or auto (on from 20000 DOFs)");
+  const Case c = load_case(dir.write("on.yaml", text("on")));
+  EXPECT_EQ(c.update->options.reduced_basis, FitOptions::ReducedBasis::kOn);
+  const UpdateRun run = update_case(c);
+  EXPECT_FALSE(run.fit.reduced_basis);
+  EXPECT_TRUE(HasWarning(run.fit, "the reduced-basis fit does not apply here"));
+}
+
 TEST(SmuRealData, FourStoryShearFrame) {
   // Real identified modes. Before: frequency errors up to 12 %, MAC down to 0.70; after: < 0.2 % and > 0.99.
   const FitRun r = Update(test::CasesDir() + "/smu-four-story");

@@ -43,8 +43,10 @@ std::vector<int> element_list(const YAML::Node& n, const YamlCtx& ctx, const Mod
 
 UpdateSpec parse_update(const YAML::Node& n, const YamlCtx& ctx, const Model& model, const std::string& dir) {
   ctx.require_map(n, "update");
-  ctx.only_keys(n, "update", {"measured", "geometry", "target", "modes", "objective", "parameters", "noise", "regularization",
-                              "loss", "loss_scale", "solver", "max_iterations", "min_mac", "extra_modes", "multistart"});
+  ctx.only_keys(
+      n, "update",
+      {"measured", "geometry", "target", "modes", "objective", "parameters", "noise", "regularization", "loss",
+       "loss_scale", "solver", "max_iterations", "min_mac", "extra_modes", "multistart", "reduced_basis"});
   UpdateSpec u;
   FitOptions& o = u.options;
   if (n["measured"] && n["target"]) ctx.fail(n, "update: give either measured: (a file) or target: (a simulation), not both");
@@ -123,6 +125,18 @@ UpdateSpec parse_update(const YAML::Node& n, const YamlCtx& ctx, const Model& mo
   if (n["max_iterations"]) o.max_iterations = ctx.integer(n["max_iterations"], "max_iterations");
   if (n["min_mac"]) o.min_mac = ctx.number(n["min_mac"], "min_mac");
   if (n["extra_modes"]) o.extra_modes = ctx.integer(n["extra_modes"], "extra_modes");
+  if (n["reduced_basis"]) {
+    const std::string s = ctx.string(n["reduced_basis"], "reduced_basis");
+    if (s == "off")
+      o.reduced_basis = FitOptions::ReducedBasis::kOff;
+    else if (s == "on")
+      o.reduced_basis = FitOptions::ReducedBasis::kOn;
+    else if (s == "auto")
+      o.reduced_basis = FitOptions::ReducedBasis::kAuto;
+    else
+      ctx.fail(n["reduced_basis"], "update: reduced_basis must be off, on or auto (on from " +
+                                       std::to_string(o.reduced_basis_min_dofs) + " DOFs)");
+  }
   if (n["multistart"]) {  // true | false | {starts: N, continuation: bool, seed: N}
     const YAML::Node& q = n["multistart"];
     if (q.IsScalar()) {

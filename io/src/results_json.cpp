@@ -136,6 +136,10 @@ nlohmann::json update_json(const std::string& case_name, const ParametricModel& 
   j["objective"] = std::string(fit_objective_name(u.options.objective));
   j["iterations"] = f.iterations;
   j["model_evaluations"] = f.evaluations;
+  if (f.reduced_basis)
+    j["reduced_basis"] = {{"steps_rejected", f.rejected_steps},
+                          {"surrogate_iterations", f.surrogate_iterations},
+                          {"seconds_in_surrogates", f.time_surrogate}};
   j["cost"] = {{"initial", f.initial_cost}, {"final", f.final_cost}, {"history", f.cost_history}};
   j["termination"] = f.termination;
   j["converged"] = f.converged;
