@@ -927,7 +927,7 @@ void estimate_covariance(const Evaluation& ef, const ParametricModel& pm, const 
 // shrinks (poor prediction, rejected step). Stops when the surrogate, which matches the full cost and gradient at
 // the current point, predicts no decrease beyond function_tolerance, or when a step is too small to matter.
 // `x` (the full problem's variables) holds the start and returns the result; false if the surrogate could not be
-// built at the start (the caller then runs the direct fit).
+// built (at the start, or after a step, with a warning): the caller then runs the direct fit from `x`.
 bool reduced_basis_fit(ceres::Problem* full_problem, Evaluator* full, const ParametricModel& pm,
                        const ModalData& measured, const Eigen::VectorXd& theta0, const std::vector<int>& free,
                        const FitOptions& o, std::vector<double>* x, FitSummary* out) {
@@ -962,11 +962,10 @@ bool reduced_basis_fit(ceres::Problem* full_problem, Evaluator* full, const Para
   for (int step = 0; step < o.max_iterations;) {
     const auto te = std::chrono::steady_clock::now();
     if (!expanded && !sur->expand(*full, x->data())) {
-      out->termination = "FAILURE";
-      out->warnings.push_back(
-          "the reduced-basis surrogate could not be built at an iterate (its pairing differs from "
-          "the full model's); the fit stopped there");
-      break;
+      out->warnings.push_back("the reduced-basis surrogate could not be built after step " + std::to_string(step) +
+                              " (it pairs the modes differently from the full model there): the direct fit "
+                              "continued from that point");
+      return false;
     }
     expanded = true;
     out->time_surrogate += std::chrono::duration<double>(std::chrono::steady_clock::now() - te).count();
@@ -1071,9 +1070,11 @@ FitSummary fit_parameters(const ParametricModel& pm, const ModalData& measured, 
         "the reduced-basis fit does not apply here (f2 objective, a model solved densely, or a "
         "free-free model): the direct fit ran");
   if (want_reduced && ev->reduced_basis_applies()) {
+    const std::size_t warned = out.warnings.size();
     reduced = reduced_basis_fit(&problem, ev.get(), pm, measured, theta0, free, o, &x, &out);
-    if (!reduced)
+    if (!reduced && out.warnings.size() == warned)
       out.warnings.push_back("the reduced-basis surrogate could not be built at the start values: the direct fit ran");
+    if (!reduced) out.cost_history.clear();
   }
   if (!reduced) {
     ceres::Solver::Options so = solver_options(o);
