@@ -226,8 +226,8 @@ TEST(Update, ReducedBasisFitReachesTheDirectFitsMinimum) {
   // The reduced-basis fit (surrogates on the modes and one Krylov block, corrected to the full model's residuals
   // and Jacobian at each step) against Ceres on the full model at every step: the same minimum with fewer
   // eigen-solves. Tolerances: the two stop within the direct fit's own truncation of the shape derivatives
-  // (a relative gradient error of ~1e-3), so the costs agree to 1e-4 (measured: 1.6e-6) and the parameters
-  // to a tenth of their standard deviations (measured: under 0.01 of them).
+  // (a relative gradient error of ~1e-3), so the costs agree to 1e-4 (measured: 1e-7) and the parameters
+  // to a tenth of their standard deviations (measured: 4e-4 of them).
   const FrameFit f = SpaceFrameFit();
   ASSERT_GT(f.model.num_dofs(), f.options.dense_max_dofs);
   FitOptions o = f.options;
@@ -240,17 +240,19 @@ TEST(Update, ReducedBasisFitReachesTheDirectFitsMinimum) {
   EXPECT_TRUE(reduced.reduced_basis);
   EXPECT_LT(reduced.final_cost, direct.final_cost * (1 + 1e-4)) << reduced.report;
   EXPECT_GT(reduced.final_cost, direct.final_cost * (1 - 1e-4)) << reduced.report;
+  double worst = 0;  // the largest parameter difference in standard deviations
   for (int p = 0; p < f.pm->num_parameters(); ++p) {
     ASSERT_TRUE(std::isfinite(direct.stddev[p]));
+    worst = std::max(worst, std::abs(reduced.theta[p] - direct.theta[p]) / direct.stddev[p]);
     EXPECT_LT(std::abs(reduced.theta[p] - direct.theta[p]), 0.1 * direct.stddev[p]) << "parameter " << p;
     EXPECT_NEAR(reduced.stddev[p], direct.stddev[p], 0.01 * direct.stddev[p]) << "parameter " << p;
   }
   EXPECT_LT(reduced.evaluations, direct.evaluations);
   std::printf(
       "direct: cost %.8g, %d iterations, %d eigen-solves; reduced: cost %.8g, %d steps (%d rejected), %d "
-      "eigen-solves, %d surrogate iterations\n",
+      "eigen-solves, %d surrogate iterations; parameters apart by at most %.3g std\n",
       direct.final_cost, direct.iterations, direct.evaluations, reduced.final_cost, reduced.iterations,
-      reduced.rejected_steps, reduced.evaluations, reduced.surrogate_iterations);
+      reduced.rejected_steps, reduced.evaluations, reduced.surrogate_iterations, worst);
 }
 
 TEST(Update, ReducedBasisOnlyWhereItApplies) {
