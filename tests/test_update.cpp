@@ -1,11 +1,14 @@
 // Model updating with Ceres: the paper's Table 1 beam (f1, f2, combined), ties, fixed parameters, bounds,
 // ill-posed set-ups, and the SMU real shear frames.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <memory>
 #include <random>
 
+#include "dynid/engine/modal.hpp"
+#include "dynid/engine/modal_data.hpp"
 #include "dynid/engine/model_fit.hpp"
 #include "dynid/io/case_file.hpp"
 #include "dynid/io/results_json.hpp"
@@ -126,6 +129,59 @@ TEST(Update, PartnerThreeTimesAwayIsLeftUnpaired) {
   for (const Parameter& p : c.update->parameters) pm.add(p);
   const PlausibleModes pl = plausible_modes(pm, m, c.update->initial, c.update->options);
   EXPECT_EQ(pl.unpaired, std::vector<int>{5});
+}
+
+// A free-free beam (2 m steel, 20 elements) held at node 1 by a fitted support spring (translation and rotation):
+// a spring-clamped cantilever. The fit deflates the rigid-body motions only while K leaves them free; with the
+// springs at their values they are tied down. The same model in mm, t, s (E in MPa, rho in t/mm^3, k in N/mm and
+// N mm/rad) must give the same frequencies: the test of "free" used to compare ||K R|| with ||K||_1, which in mm
+// is ruled by the rotational rows (10^6 times the translational ones), so it called the tied motions free and
+// reported the first mode as rigid (0 Hz). Reference: the same structure with explicit spring elements (no rigid
+// body motion), solved densely. Tolerance 1e-6 relative: the sparse path's eigenvalues to its Lanczos tolerance.
+TEST(Update, RigidBodyTestDoesNotDependOnTheUnits) {
+  struct Units {
+    double length, E, rho, k;  // factors from SI
+  };
+  for (const Units u : {Units{1, 1, 1, 1}, Units{1e3, 1e-6, 1e-12, 1e-3}}) {
+    BeamSpec b;
+    b.length = 2.0 * u.length;
+    b.elements = 20;
+    b.material = {"steel", 2.1e11 * u.E, 0, 0.3, 7850 * u.rho};
+    b.section = {"s", 0.01 * u.length * u.length, 0, 1e-4 / 12 * std::pow(u.length, 4), 0};
+    const Model free = make_beam(b);
+    ASSERT_TRUE(free.free_free());
+    const double kt = 1e9 * u.k, kr = 1e8 * u.k * u.length;  // N/m -> N/mm; N m/rad -> N mm/rad
+    Model held = test::UnsupportedCopy(free);
+    held.add_element(test::GroundedSpring(9001, 1, Dof::UY, kt));
+    held.add_element(test::GroundedSpring(9002, 1, Dof::RZ, kr));
+    held.finalize();
+    EigenOptions eo;
+    eo.num_modes = 4;
+    eo.method = EigenOptions::Method::kDense;
+    const ModalResult ref = modal_analysis(held, eo);
+    ASSERT_TRUE(ref.ok());
+    ASSERT_EQ(std::count(ref.rigid_body.begin(), ref.rigid_body.end(), 1), 0);
+    const ModalData meas = sample_modes(held, ref, dofs_of_types(held, dof_bit(Dof::UY)), 0, 4, "exact");
+    ParametricModel pm(free);
+    Parameter t;
+    t.name = "kt";
+    t.kind = ParameterKind::kSpring;
+    t.node = free.node_index(1);
+    t.dofs = dof_bit(Dof::UY);
+    t.nominal = 0;
+    Parameter r = t;
+    r.name = "kr";
+    r.dofs = dof_bit(Dof::RZ);
+    pm.add(t);
+    pm.add(r);
+    const Correlation c = correlate(pm, meas, Eigen::Vector2d(kt, kr), FitOptions{});
+    ASSERT_EQ(c.model_hz.size(), 4);
+    for (int k = 0; k < 4; ++k) {
+      EXPECT_EQ(c.model_mode[k], k) << "units x" << u.length << ", mode " << k + 1;
+      EXPECT_TRUE(test::RelClose(c.model_hz[k], meas.frequencies_hz[k], 1e-6))
+          << "units x" << u.length << ", mode " << k + 1;
+    }
+  }
 }
 
 TEST(Update, RobustLossResistsAnOutlierMode) {

@@ -476,13 +476,14 @@ EigenSolution solve_local_system(const detail::DistributedHost& host, const Loca
     fill_local(ls, sol.modes.col(k).data(), x.h);
     DYNID_PETSC(MatMult(K.h, x.h, kx.h));
     DYNID_PETSC(MatMult(M.h, x.h, mx.h));
-    PetscReal nkx = 0, nx = 0, nr = 0;
-    DYNID_PETSC(VecNorm(kx.h, NORM_2, &nkx));
+    PetscReal nx = 0, nr = 0;
     DYNID_PETSC(VecNorm(x.h, NORM_2, &nx));
     DYNID_PETSC(VecAXPY(kx.h, -sol.eigenvalues[k], mx.h));
     DYNID_PETSC(VecNorm(kx.h, NORM_2, &nr));
     sol.residuals[k] = nr / ((nK + std::abs(sol.eigenvalues[k]) * nM) * nx);
-    if (r == 0 && sigma < 0 && opt.allow_singular_stiffness && nkx <= opt.rigid_residual_tolerance * nK * nx)
+    // s0 / sqrt(eps) = max_i K_ii / M_ii: the eigenvalue test of EigenOptions::rigid_eigenvalue_tolerance.
+    if (r == 0 && sigma < 0 && opt.allow_singular_stiffness &&
+        sol.eigenvalues[k] <= opt.rigid_eigenvalue_tolerance * s0 / std::sqrt(std::numeric_limits<double>::epsilon()))
       sol.rigid_body[k] = 1;
   }
   if (r == 0) sum.num_rigid = static_cast<int>(std::count(sol.rigid_body.begin(), sol.rigid_body.end(), 1));

@@ -245,7 +245,8 @@ bool EigenOptions::IsValid(std::string* why) const {
   if (max_restarts < 1) return fail("max_restarts must be >= 1");
   if (subspace < 0) return fail("subspace must be >= 0");
   if (!std::isnan(shift) && !std::isfinite(shift)) return fail("shift must be finite");
-  if (!(rigid_residual_tolerance > 0)) return fail("rigid_residual_tolerance must be > 0");
+  if (!(rigid_eigenvalue_tolerance > 0 && rigid_eigenvalue_tolerance < 1))
+    return fail("rigid_eigenvalue_tolerance must be in (0, 1)");
   if (backend == Backend::kDistributed && lo)
     return fail("the distributed backend solves the lowest modes only; a band needs the local backend");
   if (!(iterative_tolerance > 0 && iterative_tolerance < 1)) return fail("iterative_tolerance must be in (0, 1)");
@@ -657,14 +658,12 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
   }
   sol.rigid_body = rigid;
 
-  // Without a rigid basis, zero-energy modes of a singular K are recognised by their residual ||K phi||.
+  // Without a rigid basis, zero-energy modes of a singular K are recognised by their eigenvalue (EigenOptions).
   const double nK = norm1(Ku), nM = norm1(Mu);
   if (r == 0 && sigma < 0 && opt.allow_singular_stiffness) {
-    for (Eigen::Index k = 0; k < m; ++k) {
-      Eigen::VectorXd kp(n);
-      symmetric_multiply(Ku, sol.modes.col(k).data(), kp.data());
-      if (kp.norm() <= opt.rigid_residual_tolerance * nK * sol.modes.col(k).norm()) sol.rigid_body[k] = 1;
-    }
+    const double zero = opt.rigid_eigenvalue_tolerance * max_stiffness_to_mass(kd, md);
+    for (Eigen::Index k = 0; k < m; ++k)
+      if (sol.eigenvalues[k] <= zero) sol.rigid_body[k] = 1;
     sum.num_rigid = static_cast<int>(std::count(sol.rigid_body.begin(), sol.rigid_body.end(), 1));
   }
   finish(&sol);
@@ -766,16 +765,13 @@ EigenSolution solve_eigen_dense(const Eigen::MatrixXd& K, const Eigen::MatrixXd&
       V.col(static_cast<Eigen::Index>(k)) = llt.matrixU().solve(es.eigenvectors().col(i)) / std::sqrt(th[i]);
     }
   }
-  // Rigid-body modes: as many as the supplied basis has (they are the lowest), else by residual ||K phi||.
+  // Rigid-body modes: as many as the supplied basis has (they are the lowest), else by their eigenvalue
+  // (EigenOptions::rigid_eigenvalue_tolerance: the same test whatever the units of the DOFs).
   const Eigen::Index r = opt.rigid_body_basis.cols();
   const double nK = Ks.cwiseAbs().colwise().sum().maxCoeff(), nM = Ms.cwiseAbs().colwise().sum().maxCoeff();
+  const double zero = opt.rigid_eigenvalue_tolerance * max_stiffness_to_mass(Ks.diagonal(), Ms.diagonal());
   std::vector<char> rigid(static_cast<std::size_t>(lam.size()), 0);
-  for (Eigen::Index k = 0; k < lam.size(); ++k) {
-    if (r > 0)
-      rigid[k] = k < r;
-    else
-      rigid[k] = (Ks * V.col(k)).norm() <= opt.rigid_residual_tolerance * nK * V.col(k).norm();
-  }
+  for (Eigen::Index k = 0; k < lam.size(); ++k) rigid[k] = r > 0 ? k < r : lam[k] <= zero;
   std::vector<Eigen::Index> keep;
   for (Eigen::Index k = 0; k < lam.size(); ++k) {
     if (band_mode(opt) ? (rigid[k] ? opt.band_lo <= 0 : in_band(lam[k], opt))
