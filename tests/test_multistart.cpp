@@ -112,6 +112,33 @@ TEST(MeasuredUncertainty, JsonPerEntryShapeStd) {
   EXPECT_HAS(test::ErrorOf([&] { parse_modal_data_json(bad, "bad.json"); }), "bad.json: mode 1 has shape standard deviation");
 }
 
+// JSON: a mode may list mode 1's DOFs in another order (JSON objects have none; writers sort keys or not), each
+// entry with its own UFF-style sign ("2-X" is -1 times "2+X"); shape_std alike. A DOF mode 1 lacks, a repeated
+// one, and a label that is no DOF are errors naming the mode and the label. Exact: values are copied.
+TEST(MeasuredUncertainty, JsonDofsInAnyOrderEachWithItsSign) {
+  const std::string ordered = R"({"modes": [
+    {"frequency_hz": 2, "shape": {"1ux": 1, "2ux": 0.5, "3uy": 0.2}, "shape_std": {"1ux": 0, "2ux": 0.03, "3uy": 0.01}},
+    {"frequency_hz": 5, "shape": {"1ux": -0.4, "2ux": 1, "3uy": 0.7}, "shape_std": {"1ux": 0.05, "2ux": 0, "3uy": 0.02}}]})";
+  const std::string shuffled = R"({"modes": [
+    {"frequency_hz": 2, "shape": {"1ux": 1, "2ux": 0.5, "3uy": 0.2}, "shape_std": {"2ux": 0.03, "1ux": 0, "3uy": 0.01}},
+    {"frequency_hz": 5, "shape": {"3+Y": 0.7, "2-X": -1, "1ux": -0.4}, "shape_std": {"3uy": 0.02, "1ux": 0.05, "2ux": 0}}]})";
+  const ModalData a = parse_modal_data_json(ordered, "a.json"), b = parse_modal_data_json(shuffled, "b.json");
+  ASSERT_EQ(b.dofs.size(), 3u);
+  for (std::size_t r = 0; r < 3; ++r) EXPECT_TRUE(a.dofs[r] == b.dofs[r]) << r;
+  EXPECT_EQ(a.shapes, b.shapes);
+  EXPECT_EQ(a.shape_entry_std, b.shape_entry_std);
+  auto error = [&](const std::string& from, const std::string& to) {
+    std::string t = shuffled;
+    t.replace(t.find(from), from.size(), to);
+    return test::ErrorOf([&] { parse_modal_data_json(t, "b.json"); });
+  };
+  EXPECT_HAS(error("\"2-X\": -1", "\"4ux\": -1"), "b.json: mode 2: DOF \"4ux\" is not among mode 1's DOFs");
+  EXPECT_HAS(error("\"2-X\": -1", "\"3uy\": -1"), "b.json: mode 2: DOF \"3uy\" is listed twice");
+  EXPECT_HAS(error("\"2-X\": -1", "\"left\": -1"), "b.json: mode 2: \"left\" is not a DOF label");
+  EXPECT_HAS(error("\"3uy\": 0.02", "\"3ux\": 0.02"),
+             "b.json: mode 2 shape_std: DOF \"3ux\" is not among the shape's DOFs");
+}
+
 // The global search on the 18-story frame (6 stiffness groups): the same starts, costs and minima with 1 and 2
 // threads (exactly: the starts are independent); every start accounted for in one minimum; the best no worse than
 // start 0 (the single fit from the initial values); the rule's number of starts (2 per parameter, 8..32).

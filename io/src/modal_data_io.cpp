@@ -1,5 +1,6 @@
 #include "dynid/io/modal_data_io.hpp"
 
+#include <algorithm>
 #include <cctype>
 
 #include "dynid/io/output.hpp"
@@ -56,7 +57,6 @@ ModalData parse_modal_data_json(const std::string& text, const std::string& name
   if (modes.empty()) throw InputError(name + ": \"modes\" is empty");
   ModalData d;
   d.source = name;
-  std::vector<double> sign;
   for (std::size_t k = 0; k < modes.size(); ++k) {
     const auto& m = modes[k];
     const std::string who = name + ": mode " + std::to_string(k + 1);
@@ -67,25 +67,31 @@ ModalData parse_modal_data_json(const std::string& text, const std::string& name
     if (k == 0) {
       for (auto it = sh.begin(); it != sh.end(); ++it) {
         MeasuredDof md;
-        double s = 1;
-        if (!parse_dof_label(it.key(), &md, &s))
+        if (!parse_dof_label(it.key(), &md, nullptr))
           throw InputError(who + ": \"" + it.key() + "\" is not a DOF label (expected node id + direction, e.g. \"13ux\" or \"13+X\")");
         d.dofs.push_back(md);
-        sign.push_back(s);
       }
       d.shapes.resize(static_cast<Eigen::Index>(d.dofs.size()), static_cast<Eigen::Index>(modes.size()));
       d.frequencies_hz.resize(static_cast<Eigen::Index>(modes.size()));
     }
     if (sh.size() != d.dofs.size())
       throw InputError(who + ": has " + std::to_string(sh.size()) + " DOFs, mode 1 has " + std::to_string(d.dofs.size()));
-    std::size_t r = 0;
-    for (auto it = sh.begin(); it != sh.end(); ++it, ++r) {
+    // The same DOFs as mode 1, in any order, each with its own sign (13+Y or 13-Y).
+    std::vector<char> filled(d.dofs.size(), 0);
+    for (auto it = sh.begin(); it != sh.end(); ++it) {
       MeasuredDof md;
       double s = 1;
-      if (!parse_dof_label(it.key(), &md, &s) || !(md == d.dofs[r]))
-        throw InputError(who + ": DOF \"" + it.key() + "\" differs from mode 1's DOFs (every mode must list the same DOFs)");
+      if (!parse_dof_label(it.key(), &md, &s))
+        throw InputError(who + ": \"" + it.key() +
+                         "\" is not a DOF label (expected node id + direction, e.g. \"13ux\" or \"13+X\")");
+      const std::size_t r = static_cast<std::size_t>(std::find(d.dofs.begin(), d.dofs.end(), md) - d.dofs.begin());
+      if (r == d.dofs.size())
+        throw InputError(who + ": DOF \"" + it.key() +
+                         "\" is not among mode 1's DOFs (every mode must list the same DOFs)");
+      if (filled[r]) throw InputError(who + ": DOF \"" + it.key() + "\" is listed twice");
       if (!it.value().is_number()) throw InputError(who + ": value of \"" + it.key() + "\" is not a number");
-      d.shapes(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(k)) = sign[r] * it.value().get<double>();
+      filled[r] = 1;
+      d.shapes(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(k)) = s * it.value().get<double>();
     }
     d.frequencies_hz[static_cast<Eigen::Index>(k)] = m["frequency_hz"].get<double>();
   }
@@ -115,12 +121,17 @@ ModalData parse_modal_data_json(const std::string& text, const std::string& name
     const std::string who = name + ": mode " + std::to_string(k + 1) + " shape_std";
     if (sd.size() != d.dofs.size())
       throw InputError(who + ": has " + std::to_string(sd.size()) + " DOFs, the shape " + std::to_string(d.dofs.size()) + " (one std per shape entry)");
-    std::size_t r = 0;
-    for (auto it = sd.begin(); it != sd.end(); ++it, ++r) {
+    std::vector<char> filled(d.dofs.size(), 0);
+    for (auto it = sd.begin(); it != sd.end(); ++it) {
       MeasuredDof md;
-      if (!parse_dof_label(it.key(), &md, nullptr) || !(md == d.dofs[r]))
-        throw InputError(who + ": DOF \"" + it.key() + "\" differs from the shape's DOFs (same DOFs, same order)");
+      const std::size_t r = parse_dof_label(it.key(), &md, nullptr)
+                                ? static_cast<std::size_t>(std::find(d.dofs.begin(), d.dofs.end(), md) - d.dofs.begin())
+                                : d.dofs.size();
+      if (r == d.dofs.size())
+        throw InputError(who + ": DOF \"" + it.key() + "\" is not among the shape's DOFs (one std per shape entry)");
+      if (filled[r]) throw InputError(who + ": DOF \"" + it.key() + "\" is listed twice");
       if (!it.value().is_number()) throw InputError(who + ": value of \"" + it.key() + "\" is not a number");
+      filled[r] = 1;
       d.shape_entry_std(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(k)) = it.value().get<double>();
     }
   }
