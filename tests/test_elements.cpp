@@ -196,7 +196,7 @@ TEST(ElementRegistry, MemberOnlyQueriesRejectOtherKinds) {
   m.finalize();
   EXPECT_THROW(m.unit_geometric_stiffness(0), InputError);
   EXPECT_THROW(m.member_point_interpolation(0, 0.5), InputError);
-  EXPECT_THROW(m.member_shear_mass_parts(0), InputError);
+  EXPECT_THROW(m.member_bending_planes(0), InputError);
   EXPECT_EQ(m.member_axial_force(0, Eigen::VectorXd::Ones(1)), 0.0);
 }
 

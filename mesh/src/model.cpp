@@ -280,9 +280,9 @@ Eigen::MatrixXd Model::unit_geometric_stiffness(int e) const {
   return element_kind(elements_[e].type).unit_geometric_stiffness(*this, e);
 }
 
-std::array<Eigen::MatrixXd, 6> Model::member_shear_mass_parts(int e) const {
-  require_finalized("member_shear_mass_parts");
-  return element_kind(elements_[e].type).shear_mass_parts(*this, e);
+std::vector<BendingPlane> Model::member_bending_planes(int e) const {
+  require_finalized("member_bending_planes");
+  return element_kind(elements_[e].type).bending_planes(*this, e);
 }
 
 Eigen::MatrixXd Model::member_point_interpolation(int e, double xi, Eigen::MatrixXd* dN) const {

@@ -1,15 +1,17 @@
 // shear_deformation: the members are Timoshenko beams (shear deformation and rotary inertia), not
 // Euler-Bernoulli ones.
 //
-// Per member (plane bending): K_b(alpha) = (K_b + alpha phi0 EI/L d d^T) / (1 + alpha phi0), phi0 = 12 EI/(G A L^2),
-// d = e_t1 - e_t2 on the rotations; alpha = 1/kappa (0 = Euler-Bernoulli), the exact Timoshenko stiffness of the
-// two-node element. Its mass is the one consistent with that stiffness (Model::member_shear_mass_parts, Friedman &
+// Per member and bending plane (one for plane members, two for space frames, one kappa for both):
+// K_b(alpha) = (K_b + alpha phi0 EI/L d d^T) / (1 + alpha phi0), phi0 = 12 EI/(G A L^2), d = e_t1 - e_t2 on the
+// end rotations about the plane's normal; alpha = 1/kappa (0 = Euler-Bernoulli), the exact Timoshenko stiffness of
+// the two-node element. Its mass is the one consistent with that stiffness (Model::member_bending_planes, Friedman &
 // Kosmatka): the translational mass of its shape functions and the rotary inertia of the section's rotation (not
 // of the slope w', which shear adds to: the Rayleigh term over-weights rotary inertia in thick members, and a
 // kappa fitted with it came out high). The rotary inertia enters with the weight w(alpha) = 1 - exp(-(alpha /
 // 0.45)^2): none at alpha = 0 (the model as given), over 99 % from alpha = 1 on (kappa <= 1, every real section),
 // so that the candidate is the nominal model at its nominal parameter and Timoshenko's beam where it matters.
 // Models that already include rotary inertia have it replaced by the section rotation's.
+#include <array>
 #include <cmath>
 
 #include "candidates/common.hpp"
@@ -34,32 +36,51 @@ class ShearDeformation : public Candidate {
   std::vector<CustomTerm> terms(const Model& m, int first) const override {
     std::vector<CustomTerm> out;
     for (int e : els_) {
-      const Member mb = member(m, e);
-      Eigen::VectorXd d = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mb.dofs.size()));
-      int seen = 0;
-      for (std::size_t k = 0; k < mb.types.size(); ++k)
-        if (mb.types[k].second == Dof::RZ) d[static_cast<Eigen::Index>(k)] = seen++ == 0 ? 1.0 : -1.0;
-      const Eigen::MatrixXd D = (mb.EI / mb.L) * d * d.transpose();
-      const double phi0 = 12.0 * mb.EI / (mb.GA * mb.L * mb.L);
+      // Per bending plane: its stiffness, the shear term (E I / L) d d^T, phi0 = 12 E I / (G A L^2) and the mass
+      // parts (Model::member_bending_planes).
+      struct Plane {
+        Eigen::MatrixXd Kb, D;
+        double phi0;
+        std::array<Eigen::MatrixXd, 6> P;
+      };
+      std::vector<Plane> planes;
+      for (BendingPlane& b : m.member_bending_planes(e)) {
+        if (!(b.EI > 0) || !(b.GA > 0)) continue;
+        planes.push_back(
+            {std::move(b.K), (b.EI / b.L) * b.d * b.d.transpose(), 12.0 * b.EI / (b.GA * b.L * b.L), b.mass});
+      }
+      if (planes.empty()) continue;
       CustomTerm t;
-      t.dofs = mb.dofs;
+      m.element_dofs(e, &t.dofs);
       t.params = {first};
-      t.eval = [Kb = mb.Kb, D, phi0, P = m.member_shear_mass_parts(e), rotary = m.rotary_inertia()](
-                   const Eigen::VectorXd& th, Eigen::MatrixXd* dK, Eigen::MatrixXd* dM,
-                   std::vector<Eigen::MatrixXd>* dKd, std::vector<Eigen::MatrixXd>* dMd) {
-        const double a = th[0], phi = a * phi0, q = 1.0 + phi, x = a / kRotaryRamp, g = std::exp(-x * x);
-        // The mass part at phi (shear_mass) and its derivative in alpha.
-        auto part = [&](int o) -> Eigen::MatrixXd { return shear_mass(P[o], P[o + 1], P[o + 2], phi); };
-        auto slope = [&](int o) -> Eigen::MatrixXd {
-          return phi0 * ((P[o + 1] + 2.0 * phi * P[o + 2]) * q - 2.0 * (P[o] + phi * P[o + 1] + phi * phi * P[o + 2])) /
-                 (q * q * q);
-        };
+      t.eval = [planes, rotary = m.rotary_inertia()](const Eigen::VectorXd& th, Eigen::MatrixXd* dK,
+                                                     Eigen::MatrixXd* dM, std::vector<Eigen::MatrixXd>* dKd,
+                                                     std::vector<Eigen::MatrixXd>* dMd) {
+        const double a = th[0], x = a / kRotaryRamp, g = std::exp(-x * x);
         // Rotary inertia: replaces the model's (rotary) or enters with the weight w = 1 - g.
         const double w = rotary ? 1.0 : 1.0 - g, dw = rotary ? 0.0 : 2.0 * x / kRotaryRamp * g;
-        if (dK) *dK = (Kb + a * phi0 * D) / q - Kb;
-        if (dM) *dM = part(0) - P[0] + w * part(3) - (rotary ? P[3] : Eigen::MatrixXd::Zero(P[3].rows(), P[3].cols()));
-        if (dKd) *dKd = {phi0 * (D - Kb) / (q * q)};
-        if (dMd) *dMd = {slope(0) + w * slope(3) + dw * part(3)};
+        const Eigen::Index n = planes[0].Kb.rows();
+        Eigen::MatrixXd K = Eigen::MatrixXd::Zero(n, n), M = K, Kd = K, Md = K;
+        for (const Plane& pl : planes) {
+          const double phi0 = pl.phi0, phi = a * phi0, q = 1.0 + phi;
+          const auto& P = pl.P;
+          // The mass part at phi (shear_mass) and its derivative in alpha.
+          auto part = [&](int o) -> Eigen::MatrixXd { return shear_mass(P[o], P[o + 1], P[o + 2], phi); };
+          auto slope = [&](int o) -> Eigen::MatrixXd {
+            return phi0 *
+                   ((P[o + 1] + 2.0 * phi * P[o + 2]) * q - 2.0 * (P[o] + phi * P[o + 1] + phi * phi * P[o + 2])) /
+                   (q * q * q);
+          };
+          K += (pl.Kb + phi * pl.D) / q - pl.Kb;
+          M += part(0) - P[0] + w * part(3);
+          if (rotary) M -= P[3];
+          Kd += phi0 * (pl.D - pl.Kb) / (q * q);
+          Md += slope(0) + w * slope(3) + dw * part(3);
+        }
+        if (dK) *dK = K;
+        if (dM) *dM = M;
+        if (dKd) *dKd = {Kd};
+        if (dMd) *dMd = {Md};
       };
       out.push_back(std::move(t));
     }
@@ -81,13 +102,11 @@ class ShearDeformation : public Candidate {
 }  // namespace
 
 CandidateKind shear_deformation_kind() {
-  return {"shear_deformation", Nature::kBoth, "shear deformation and rotary inertia in every plane member (Timoshenko)",
+  return {"shear_deformation", Nature::kBoth, "shear deformation and rotary inertia in every member (Timoshenko)",
           [](const CandidateContext& c) {
             std::vector<std::unique_ptr<Candidate>> out;
             const std::vector<int> all = group_members(*c.model, "");
-            bool plane = !all.empty();
-            for (int e : all) plane = plane && !element_kind(c.model->elements()[e].type).spatial();
-            if (plane) out.push_back(std::make_unique<ShearDeformation>(*c.model, all));
+            if (!all.empty()) out.push_back(std::make_unique<ShearDeformation>(*c.model, all));
             return out;
           }};
 }

@@ -164,20 +164,45 @@ Eigen::MatrixXd MemberKind::unit_geometric_stiffness(const Model& m, int e) cons
   return T.transpose() * loc.Kg * T;
 }
 
-std::array<Eigen::MatrixXd, 6> MemberKind::shear_mass_parts(const Model& m, int e) const {
-  if (spatial()) return ElementKind::shear_mass_parts(m, e);
+std::vector<BendingPlane> MemberKind::bending_planes(const Model& m, int e) const {
   MemberLocal loc;
   Eigen::MatrixXd T;  // local DOFs from the element's global DOFs
   MemberProps p;
   local(m, e, &loc, &T, nullptr, &p);
-  const std::array<int, 4> bi{{1, 2, 4, 5}};
-  std::array<Eigen::MatrixXd, 6> out;
-  for (int j = 0; j < 6; ++j) {
-    const Eigen::Matrix4d c = beam_mass_coefficient(j, p.rhoA, p.rhoIz, p.L, 1.0);
-    Eigen::MatrixXd l = Eigen::MatrixXd::Zero(6, 6);
+  const Element& el = m.elements()[e];
+  const double GA =
+      m.materials()[el.material].shear_modulus() * el.factors.E * m.sections()[el.section].A * el.factors.A;
+  // Local (w1, t1, w2, t2) of each plane, its E I, rho I and the sign of t against w' (frame3d_local).
+  struct Plane {
+    std::array<int, 4> at;
+    double EI, rhoI, s;
+  };
+  const std::array<Plane, 2> space{{{{{1, 5, 7, 11}}, p.EIz, p.rhoIz, 1.0}, {{{2, 4, 8, 10}}, p.EIy, p.rhoIy, -1.0}}};
+  const Plane plane{{{1, 2, 4, 5}}, p.EIz, p.rhoIz, 1.0};
+  const Eigen::Index nl = loc.Kb.rows();
+  std::vector<BendingPlane> out;
+  for (int i = 0; i < (spatial() ? 2 : 1); ++i) {
+    const Plane& q = spatial() ? space[static_cast<std::size_t>(i)] : plane;
+    BendingPlane b;
+    b.EI = q.EI;
+    b.GA = GA;
+    b.L = p.L;
+    Eigen::MatrixXd k = Eigen::MatrixXd::Zero(nl, nl);
+    Eigen::VectorXd d = Eigen::VectorXd::Zero(nl);
     for (int r = 0; r < 4; ++r)
-      for (int s = 0; s < 4; ++s) l(bi[r], bi[s]) = c(r, s);
-    out[j] = T.transpose() * l * T;
+      for (int s = 0; s < 4; ++s) k(q.at[r], q.at[s]) = loc.Kb(q.at[r], q.at[s]);
+    d[q.at[1]] = 1.0;
+    d[q.at[3]] = -1.0;
+    b.K = T.transpose() * k * T;
+    b.d = T.transpose() * d;
+    for (int j = 0; j < 6; ++j) {
+      const Eigen::Matrix4d c = beam_mass_coefficient(j, p.rhoA, q.rhoI, p.L, q.s);
+      Eigen::MatrixXd l = Eigen::MatrixXd::Zero(nl, nl);
+      for (int r = 0; r < 4; ++r)
+        for (int s = 0; s < 4; ++s) l(q.at[r], q.at[s]) = c(r, s);
+      b.mass[static_cast<std::size_t>(j)] = T.transpose() * l * T;
+    }
+    out.push_back(std::move(b));
   }
   return out;
 }

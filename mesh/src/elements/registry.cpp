@@ -55,8 +55,8 @@ Eigen::MatrixXd ElementKind::unit_geometric_stiffness(const Model& m, int e) con
                    ": only beams and frames have a geometric stiffness");
 }
 
-std::array<Eigen::MatrixXd, 6> ElementKind::shear_mass_parts(const Model& m, int e) const {
-  throw InputError("element " + std::to_string(m.elements()[e].id) + ": only plane beams and frames have a shear mass");
+std::vector<BendingPlane> ElementKind::bending_planes(const Model& m, int e) const {
+  throw InputError("element " + std::to_string(m.elements()[e].id) + ": only beams and frames have bending planes");
 }
 
 Eigen::MatrixXd ElementKind::point_interpolation(const Model& m, int e, double, Eigen::MatrixXd*) const {

@@ -45,7 +45,7 @@ class MemberKind : public ElementKind {
   void matrices(const Model& m, int e, Eigen::MatrixXd* K, Eigen::MatrixXd* M) const override;
   Eigen::MatrixXd unit_geometric_stiffness(const Model& m, int e) const override;
   Eigen::MatrixXd point_interpolation(const Model& m, int e, double xi, Eigen::MatrixXd* dN) const override;
-  std::array<Eigen::MatrixXd, 6> shear_mass_parts(const Model& m, int e) const override;
+  std::vector<BendingPlane> bending_planes(const Model& m, int e) const override;
   double axial_force(const Model& m, int e, const Eigen::VectorXd& u) const override;
 
  protected:

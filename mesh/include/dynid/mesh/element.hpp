@@ -21,6 +21,20 @@ class Model;
 struct Element;
 struct ElementParts;
 
+/// One bending plane of a member, in global coordinates on the element's DOFs (Model::member_bending_planes): its
+/// bending stiffness K as the model has it, the end rotations' difference d = theta_1 - theta_2 about the plane's
+/// normal, E I, G A (no shear coefficient), L; and the bending mass it has as a Timoshenko beam of shear parameter
+/// phi = 12 E I / (kappa G A L^2), consistent with its stiffness (Friedman & Kosmatka 1993): translational
+/// (P[0] + phi P[1] + phi^2 P[2]) / (1 + phi)^2 and rotary (P[3] + phi P[4] + phi^2 P[5]) / (1 + phi)^2, P = mass.
+/// P[0] is the cubic-Hermite mass, P[3] the Rayleigh rotary inertia. The two-node Timoshenko stiffness at phi is
+/// (K_EB + phi (E I / L) d d^T) / (1 + phi), K_EB the Euler-Bernoulli K.
+struct BendingPlane {
+  Eigen::MatrixXd K;
+  Eigen::VectorXd d;
+  double EI = 0, GA = 0, L = 0;
+  std::array<Eigen::MatrixXd, 6> mass;
+};
+
 /// The element types; element_kind(t) gives each one's behaviour. Names (case files): element_type_name().
 enum class ElementType { Beam2D, Frame2D, Frame3D, PointMass, Spring, Matrix };
 
@@ -78,8 +92,8 @@ class ElementKind {
   virtual Eigen::MatrixXd unit_geometric_stiffness(const Model& m, int e) const;
   /// The 3 x n interpolation of the global translation at xi in [0, 1] along the axis (see Model).
   virtual Eigen::MatrixXd point_interpolation(const Model& m, int e, double xi, Eigen::MatrixXd* dN) const;
-  /// Plane members: the bending mass of a shear-deformable element, in six parts (see Model).
-  virtual std::array<Eigen::MatrixXd, 6> shear_mass_parts(const Model& m, int e) const;
+  /// The member's bending planes (see BendingPlane).
+  virtual std::vector<BendingPlane> bending_planes(const Model& m, int e) const;
   /// The axial force (tension > 0) that element displacements u produce; 0 for elements without axial DOFs.
   virtual double axial_force(const Model& m, int e, const Eigen::VectorXd& u) const;
 };

@@ -107,8 +107,8 @@ struct ElementParts {
   Eigen::MatrixXd M() const;
 };
 
-/// The Timoshenko bending mass at shear parameter phi from three parts (Model::member_shear_mass_parts' P[0..2]
-/// for the translational mass, P[3..5] for the rotary one): (c0 + phi c1 + phi^2 c2) / (1 + phi)^2.
+/// The Timoshenko bending mass at shear parameter phi from three parts (BendingPlane::mass P[0..2] for the
+/// translational mass, P[3..5] for the rotary one): (c0 + phi c1 + phi^2 c2) / (1 + phi)^2.
 template <class Mat>
 Mat shear_mass(const Mat& c0, const Mat& c1, const Mat& c2, double phi) {
   return (c0 + phi * c1 + phi * phi * c2) / ((1.0 + phi) * (1.0 + phi));
@@ -174,11 +174,9 @@ class Model : public ElementSource {
   /// Beams and frames: the consistent geometric stiffness of a unit axial tension, in global coordinates on the
   /// element's DOFs (int N'^T N' dx per bending plane). Scaled by rho I it is also the Rayleigh rotary inertia.
   Eigen::MatrixXd unit_geometric_stiffness(int e) const;
-  /// Plane beams and frames: the bending mass the element has as a Timoshenko beam of shear parameter
-  /// phi = 12 E I / (kappa G A L^2), consistent with its stiffness (Friedman & Kosmatka 1993), in global
-  /// coordinates on the element's DOFs: translational (P[0] + phi P[1] + phi^2 P[2]) / (1 + phi)^2 and rotary
-  /// (P[3] + phi P[4] + phi^2 P[5]) / (1 + phi)^2. P[0] is the cubic-Hermite mass, P[3] the Rayleigh rotary inertia.
-  std::array<Eigen::MatrixXd, 6> member_shear_mass_parts(int e) const;
+  /// Beams and frames: the element's bending planes (one for plane members, two for space frames: local x-y
+  /// about Iz, local x-z about Iy), each with what a shear-deformable (Timoshenko) member needs (BendingPlane).
+  std::vector<BendingPlane> member_bending_planes(int e) const;
   /// Beams and frames: the global translation (x, y, z) of the point at xi in [0, 1] along the member's axis
   /// from the element's DOFs (element_dof_types order), with the shape functions of its stiffness: linear
   /// axially, cubic Hermite transversely (Euler-Bernoulli). A 3 x n matrix N(xi); its derivative in xi in
