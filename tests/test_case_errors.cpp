@@ -92,6 +92,9 @@ TEST(CaseErrors, GravityAndUnitsOfDiscovery) {
   EXPECT_FALSE(mm.discover->options.si_units);
   EXPECT_EQ(mm.discover->options.gravity_acceleration, 9810.0);
   EXPECT_TRUE(parse_case(mm_model + d + "  units: si\n", "case.yaml").discover->options.si_units);  // as stated
+  // kN, m, t, s: metres by sqrt(E / rho) as in SI, tonnes by the density: not SI.
+  const std::string kn_model = Replace(kGood, "E: 2.1e11, rho: 7800", "E: 2.1e8, rho: 7.8");
+  EXPECT_FALSE(parse_case(kn_model + d, "case.yaml").discover->options.si_units);
 }
 
 // Stated noise levels are fractions: a percentage (1 for 1 %) is refused with the line and the right form, never read

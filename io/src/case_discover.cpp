@@ -197,9 +197,9 @@ DiscoverSpec parse_discover(const YAML::Node& n, const YamlCtx& ctx, const Model
     if (u != "si" && u != "other") ctx.fail(n["units"], "discover: units must be si (values labelled kg, N, m) or other (model units)");
     o.si_units = u == "si";
   } else {
-    // Not stated: SI unless the materials put the model in millimetres (mesh/units.hpp), whose masses are tonnes.
+    // Not stated: SI unless the materials put the model in millimetres or its masses in tonnes (mesh/units.hpp).
     const LengthUnit unit = length_unit(model);
-    o.si_units = !(unit.known && unit.per_metre != 1);
+    o.si_units = !(unit.known && (unit.per_metre != 1 || (unit.mass_known && unit.kilogram != 1)));
   }
   if (d.seeds < 1) ctx.fail(n["seeds"], "discover: seeds must be >= 1");
   if (d.seeds > 1 && !d.truth) ctx.fail(n["seeds"], "discover: seeds (a robustness study) needs a truth: model");

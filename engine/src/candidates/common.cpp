@@ -123,4 +123,24 @@ std::vector<std::string> member_groups(const Model& m) {
 
 std::string group_words(const std::string& g) { return g.empty() ? "all members" : "the members of group '" + g + "'"; }
 
+std::vector<DofMask> support_restraints(const Model& m) {
+  const int nn = static_cast<int>(m.nodes().size());
+  DofMask everywhere = 0;
+  for (int t = 0; t < kNumDofTypes; ++t) {
+    const DofMask b = static_cast<DofMask>(1u << t);
+    int active = 0, restrained = 0;
+    for (int n = 0; n < nn; ++n) {
+      if (!(m.dof_map().active(n) & b)) continue;
+      ++active;
+      restrained += (m.dof_map().restrained(n) & b) != 0;
+    }
+    if (active > 1 && restrained == active) everywhere |= b;
+  }
+  std::vector<DofMask> out(static_cast<std::size_t>(nn));
+  for (int n = 0; n < nn; ++n)
+    out[static_cast<std::size_t>(n)] =
+        static_cast<DofMask>(m.dof_map().active(n) & m.dof_map().restrained(n) & ~everywhere);
+  return out;
+}
+
 }  // namespace dynid::internal

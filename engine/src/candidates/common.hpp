@@ -38,4 +38,10 @@ std::vector<std::string> member_groups(const Model& m);
 /// "all members" or "the members of group 'beam'".
 std::string group_words(const std::string& g);
 
+/// Per node index, its restrained DOFs that are supports. A DOF type restrained at every node that has it (active)
+/// is no support: it holds a plane model in its plane (a plane frame given as a space frame with uz, rx, ry fixed,
+/// a beam2d line as frame2d with ux fixed), and a support, a support spring, the end of a member chain or the
+/// level gravity points from would all be read into it. Restraints on other DOF types are supports.
+std::vector<DofMask> support_restraints(const Model& m);
+
 }  // namespace dynid::internal

@@ -177,7 +177,7 @@ CandidateKind flexible_support_kind() {
               const auto [e, k] = c.member_ends[n][0];
               for (int t = 0; t < kNumDofTypes; ++t) {
                 const Dof d = static_cast<Dof>(t);
-                if (!(m.dof_map().active(n) & (1u << t)) || m.dof_map().eq(n, d) >= 0) continue;  // restrained only
+                if (!(c.support[static_cast<std::size_t>(n)] & (1u << t))) continue;  // a support's restraint only
                 if (is_rotation(d) && !bends(m, e, d)) continue;
                 auto r = std::make_unique<EndRelease>(m, e, k, d, true, length[static_cast<std::size_t>(e)]);
                 if (r->ok()) out.push_back(std::move(r));

@@ -50,7 +50,7 @@ std::vector<std::unique_ptr<Candidate>> place(const CandidateContext& c, bool ro
   std::vector<std::unique_ptr<Candidate>> out;
   const Model& m = *c.model;
   for (int n = 0; n < static_cast<int>(m.nodes().size()); ++n) {
-    const bool supported = (m.dof_map().active(n) & m.dof_map().restrained(n)) != 0;
+    const bool supported = c.support[static_cast<std::size_t>(n)] != 0;
     if (!c.node_used[n] || (rotations && !supported)) continue;
     for (int t = 0; t < kNumDofTypes; ++t) {
       const Dof d = static_cast<Dof>(t);

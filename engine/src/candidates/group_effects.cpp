@@ -215,7 +215,7 @@ class SelfStress {
     }
     if (!(restrained > 0)) {  // no axial DOFs
       int supported = 0;
-      for (int k = 0; k < static_cast<int>(m_.nodes().size()); ++k) supported += m_.dof_map().restrained(k) != 0;
+      for (DofMask s : support_restraints(m_)) supported += s != 0;
       return supported >= 2 ? std::optional<PreloadState>(alone) : std::nullopt;
     }
     if (!factor_) return alone;  // free-free or a mechanism: cannot say, keep the candidate

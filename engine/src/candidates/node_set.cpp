@@ -7,10 +7,11 @@
 namespace dynid::internal {
 namespace {
 
-// The heaviest sensor the sensor-mass candidate finds plausible (SI models): a seismic accelerometer with its
-// mounting block weighs up to about 1 kg, laboratory accelerometers 0.2-100 g. Tens of kilograms at every measured
-// node are not the sensors' mass, whatever else they are (a mass spread over a structure whose sensors are evenly
-// spaced). A limit on what is plausible, not a bound: the prior, normalised over the bounds, stays as it is.
+// The heaviest sensor the sensor-mass candidate finds plausible (in kg; CandidateContext::kilogram converts): a seismic
+// accelerometer with its mounting block weighs up to about 1 kg, laboratory accelerometers 0.2-100 g. Tens of kilograms
+// at every measured node are not the sensors' mass, whatever else they are (a mass spread over a structure whose
+// sensors are evenly spaced). A limit on what is plausible, not a bound: the prior, normalised over the bounds, stays
+// as it is.
 constexpr double kMaxSensorKg = 2.0;
 
 class NodeSet : public Candidate {
@@ -74,8 +75,9 @@ CandidateKind sensor_mass_kind() {
           [](const CandidateContext& c) {
             std::vector<std::unique_ptr<Candidate>> out;
             const double n = std::max<double>(1.0, static_cast<double>(c.sensor_nodes.size()));
-            auto s = std::make_unique<NodeSet>(*c.model, c.sensor_nodes, false, 0.02 * c.structure_mass / n,
-                                               c.si_units ? kMaxSensorKg : std::numeric_limits<double>::infinity());
+            auto s = std::make_unique<NodeSet>(
+                *c.model, c.sensor_nodes, false, 0.02 * c.structure_mass / n,
+                c.kilogram > 0 ? kMaxSensorKg * c.kilogram : std::numeric_limits<double>::infinity());
             if (s->ok()) out.push_back(std::move(s));
             return out;
           }};

@@ -32,23 +32,22 @@ CandidateKind suspension_stiffness_kind();
 namespace {
 
 // Chains of collinear members of one group and type joined at unsupported nodes where only they meet.
-std::vector<std::vector<int>> member_chains(const Model& m, const std::vector<std::vector<std::pair<int, int>>>& ends) {
+std::vector<std::vector<int>> member_chains(const Model& m, const std::vector<std::vector<std::pair<int, int>>>& ends,
+                                            const std::vector<DofMask>& support) {
   const int nn = static_cast<int>(m.nodes().size());
   auto dir = [&](int e) {
     const auto& n = m.element_nodes(e);
     return Eigen::Vector3d((m.nodes()[n[1]].x - m.nodes()[n[0]].x).normalized());
   };
   // A node continues a chain when exactly two members of the same group and type meet there in line, and the
-  // node has no restrained DOF.
+  // node is no support.
   std::vector<char> through(static_cast<std::size_t>(nn), 0);
   for (int n = 0; n < nn; ++n) {
     if (ends[n].size() != 2) continue;
     const int a = ends[n][0].first, b = ends[n][1].first;
     const Element &ea = m.elements()[a], &eb = m.elements()[b];
-    bool restrained = false;
-    for (int t = 0; t < kNumDofTypes; ++t)
-      restrained = restrained || ((m.dof_map().active(n) & (1u << t)) && m.dof_map().eq(n, static_cast<Dof>(t)) < 0);
-    through[n] = !restrained && ea.group == eb.group && ea.type == eb.type && std::abs(dir(a).dot(dir(b))) > 1 - 1e-9;
+    through[n] = !support[static_cast<std::size_t>(n)] && ea.group == eb.group && ea.type == eb.type &&
+                 std::abs(dir(a).dot(dir(b))) > 1 - 1e-9;
   }
   std::vector<char> seen(static_cast<std::size_t>(m.num_elements()), 0);
   std::vector<std::vector<int>> out;
@@ -107,7 +106,8 @@ CandidateContext make_context(const Model& model, const ModalData& measured, con
     const Member mb = member(model, e);
     c.structure_mass += mb.rhoA * mb.L;
   }
-  c.members = member_chains(model, c.member_ends);
+  c.support = support_restraints(model);
+  c.members = member_chains(model, c.member_ends, c.support);
   const AssembledSystem sys = assemble_system(model);
   c.stiffness_diagonal = sys.K.diagonal();
   // The band: the model's elastic modes paired with the data (the first as many as the data hold if none given).
@@ -172,16 +172,17 @@ Eigen::Vector3d default_gravity(const Model& model, bool* unconventional) {
   if (unconventional) *unconventional = false;
   if (!space) return Eigen::Vector3d(0, -1, 0);  // plane models: y up in every code we know of
   // The extent of the nodes elements use, and the highest coordinates of the supported ones (a translation
-  // restrained).
+  // restrained as a support: support_restraints).
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = Eigen::Vector3d::Constant(-INFINITY), shi = hi;
   const DofMask translations = dof_bit(Dof::UX) | dof_bit(Dof::UY) | dof_bit(Dof::UZ);
+  const std::vector<DofMask> support = support_restraints(model);
   const int nn = static_cast<int>(model.nodes().size());
   for (int n = 0; n < nn; ++n) {
     if (!model.dof_map().active(n)) continue;
     const Eigen::Vector3d& x = model.nodes()[n].x;
     lo = lo.cwiseMin(x);
     hi = hi.cwiseMax(x);
-    if (model.dof_map().restrained(n) & model.dof_map().active(n) & translations) shi = shi.cwiseMax(x);
+    if (support[static_cast<std::size_t>(n)] & translations) shi = shi.cwiseMax(x);
   }
   // Space models are drawn with z up or with y up. A structure that extends along two axes or more and has every
   // support at its lowest z (1 % of its extent there) stands on z; otherwise, every support at its lowest y, it

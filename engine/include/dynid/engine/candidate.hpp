@@ -89,6 +89,9 @@ struct CandidateContext {
   const ModalData* measured = nullptr;
   double structure_mass = 0;      ///< members (rho A L), point masses and matrix elements (rigid-translation mass)
   std::vector<char> node_used;    ///< per node index: some element connects to it
+  /// Per node index: the restrained DOFs that are supports (a DOF type restrained at every node that has it holds a
+  /// plane model in its plane: no support).
+  std::vector<DofMask> support;
   /// Per node index: the members ending there, as (element index, end 0 or 1).
   std::vector<std::vector<std::pair<int, int>>> member_ends;
   /// Members as the engineer sees them: maximal chains of collinear elements of one group joined at nodes where
@@ -107,9 +110,9 @@ struct CandidateContext {
   std::vector<int> suspension_nodes;   ///< free-free models: node indices of the suspension points
   Eigen::Vector3d gravity = Eigen::Vector3d(0, -1, 0);  ///< direction of gravity (unit)
   double gravity_acceleration = 9.81; ///< in the model's units (SI: m/s^2)
-  /// The model is in SI units (DiscoveryOptions::si_units): candidates about hardware of known size (sensors) may
-  /// judge their values in kg.
-  bool si_units = true;
+  /// One kilogram in the model's mass unit, for candidates about hardware of known size (sensors): 1 in SI
+  /// (DiscoveryOptions::si_units), 1e-3 when the masses are in tonnes (mesh/units.hpp), 0 when unknown.
+  double kilogram = 1;
 };
 
 /// A kind of candidate: its name (as in case files' `kinds:`), nature, a one-line summary, and how it places

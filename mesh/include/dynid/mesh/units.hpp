@@ -1,4 +1,4 @@
-// dynid/mesh/units.hpp -- the length unit a model's materials imply. dynid takes units as the user gives them
+// dynid/mesh/units.hpp -- the length and mass units a model's materials imply. dynid takes units as the user gives them
 // (consistent, time in seconds since frequencies are in Hz); the few physical constants it needs (gravity) must
 // be in the same units, and this is where they come from when the user does not say.
 #pragma once
@@ -20,6 +20,13 @@ struct LengthUnit {
   double per_metre = 1.0;  ///< model length units in one metre (1 or 1000)
   std::string name = "m";  ///< "m" or "mm"
   double wave_speed = 0;   ///< the members' slowest sqrt(E / rho), in model units per second (0: no material)
+  /// The mass unit, read from the densities once the length unit is known: structural materials weigh 100-25,000
+  /// kg/m^3 (timber to tungsten), 0.1-25 in t/m^3; the two ranges are 1000 times apart (N, m, kg, s against kN, m,
+  /// t, s, whose sqrt(E / rho) are the same; N, mm, t, s). Not known when the length is not, or the densities fall
+  /// in neither range or in different ones.
+  bool mass_known = false;
+  double kilogram = 1.0;         ///< one kilogram in the model's mass unit (1 or 1e-3)
+  std::string mass_name = "kg";  ///< "kg" or "t"
 };
 LengthUnit length_unit(const Model& model);
 
