@@ -892,7 +892,8 @@ TEST(Candidates, SensorMassOfMoreThanTheHeaviestSensorIsImplausible) {
   BeamSpec odd = b;  // steel's sqrt(E / rho) (metres) at a density of 1: neither kg nor t
   odd.material.E /= odd.material.rho;
   odd.material.rho = 1;
-  for (const Set& x : {Set{b, true, 1.0}, Set{b, false, 1.0}, Set{mm, false, 1e-3}, Set{odd, false, 0.0}}) {
+  for (const Set& x : {Set{b, true, 1.0}, Set{b, false, 1.0}, Set{mm, false, 1e-3}, Set{mm, true, 1e-3},
+                      Set{odd, false, 0.0}}) {
     const Model m = make_beam(x.beam);
     DiscoveryOptions o;
     o.si_units = x.si;

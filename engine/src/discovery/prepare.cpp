@@ -211,7 +211,7 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
   p.context.measured = &p.data;
   const LengthUnit unit = length_unit(model);
   p.context.gravity_acceleration = o.gravity_acceleration > 0 ? o.gravity_acceleration : gravity_acceleration(unit);
-  p.context.kilogram = o.si_units ? 1.0 : unit.mass_known ? unit.kilogram : 0.0;
+  p.context.kilogram = unit.mass_known ? unit.kilogram : o.si_units ? 1.0 : 0.0;  // the densities say, else the labels
   std::vector<CandidateKind> registry = builtin_candidate_kinds();
   registry.insert(registry.end(), o.extra_kinds.begin(), o.extra_kinds.end());
   p.library = place_candidates(p.context, registry, o.kinds);

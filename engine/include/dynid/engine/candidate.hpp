@@ -110,8 +110,9 @@ struct CandidateContext {
   std::vector<int> suspension_nodes;   ///< free-free models: node indices of the suspension points
   Eigen::Vector3d gravity = Eigen::Vector3d(0, -1, 0);  ///< direction of gravity (unit)
   double gravity_acceleration = 9.81; ///< in the model's units (SI: m/s^2)
-  /// One kilogram in the model's mass unit, for candidates about hardware of known size (sensors): 1 in SI
-  /// (DiscoveryOptions::si_units), 1e-3 when the masses are in tonnes (mesh/units.hpp), 0 when unknown.
+  /// One kilogram in the model's mass unit, for candidates about hardware of known size (sensors): as the
+  /// densities say (mesh/units.hpp: 1 for kg, 1e-3 for t), else 1 when values are labelled SI
+  /// (DiscoveryOptions::si_units), 0 (unknown) when not.
   double kilogram = 1;
 };
 
