@@ -658,8 +658,9 @@ TEST(Candidates, SemiRigidJointsOnlyWhereMembersMeet) {
 // A plane frame exported by a code that only has space frames: the portal as Frame3D elements with uz, rx and ry
 // restrained at every node (the plane held in its plane) and the bases clamped. Restraints that hold a plane model
 // in its plane are no supports (support_restraints): the library must place the same candidates as on the Frame2D
-// portal, kind by kind, on the same sites. Before, every node counted as supported, so members split into single
-// elements (member damage per element), support springs and flexible supports went to every node.
+// portal, kind by kind, on the same sites, and gravity along -y. Before, every node counted as supported, so
+// members split into single elements (member damage per element), support springs and flexible supports went to
+// every node.
 TEST(Candidates, APlaneFrameGivenAsASpaceFrameGetsThePlaneFramesCandidates) {
   const Model plane = make_frame2d(portal());
   Model space;
@@ -700,6 +701,11 @@ TEST(Candidates, APlaneFrameGivenAsASpaceFrameGetsThePlaneFramesCandidates) {
   }
   for (const auto& [kind, at] : s)
     EXPECT_TRUE(p.count(kind)) << kind << " (" << at.size() << ") only on the space frame";
+  // Gravity as in the plane model, -y, and without the warning a space model drawn with y up gets: it is flat in
+  // x-y, so y is up in it.
+  bool unconventional = true;
+  EXPECT_EQ(internal::default_gravity(space, &unconventional), Eigen::Vector3d(0, -1, 0));
+  EXPECT_FALSE(unconventional);
 }
 
 // The axial_preload candidates the library places on `m` (data: its own first `modes` modes), by description.
@@ -892,8 +898,8 @@ TEST(Candidates, SensorMassOfMoreThanTheHeaviestSensorIsImplausible) {
   BeamSpec odd = b;  // steel's sqrt(E / rho) (metres) at a density of 1: neither kg nor t
   odd.material.E /= odd.material.rho;
   odd.material.rho = 1;
-  for (const Set& x : {Set{b, true, 1.0}, Set{b, false, 1.0}, Set{mm, false, 1e-3}, Set{mm, true, 1e-3},
-                      Set{odd, false, 0.0}}) {
+  for (const Set& x :
+       {Set{b, true, 1.0}, Set{b, false, 1.0}, Set{mm, false, 1e-3}, Set{mm, true, 1e-3}, Set{odd, false, 0.0}}) {
     const Model m = make_beam(x.beam);
     DiscoveryOptions o;
     o.si_units = x.si;

@@ -199,7 +199,7 @@ Eigen::MatrixXd Model::free_rigid_body_modes(std::vector<std::string>* descripti
   if (descriptions) descriptions->clear();
   if (nc == 0) return Eigen::MatrixXd(num_dofs(), 0);
   // Y = K R and Ya = |K| |R|, element by element (no global assembly). A motion r that supports and springs
-  // leave free has ||K r|| at rounding level compared with || |K| |r| ||; a restrained one is strained at the
+  // leave free has K r at rounding level compared with |K| |r|, row by row; a restrained one is strained at the
   // supports and springs. Columns of R are unit vectors; rotations are about the centroid, so R is well
   // conditioned.
   Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(num_dofs(), nc), Ya = Y;
@@ -221,7 +221,18 @@ Eigen::MatrixXd Model::free_rigid_body_modes(std::vector<std::string>* descripti
       }
     }
   }
-  constexpr double tol = 1e-10;
+  // Each row against its own absolute sum: a row's unit (a force, a moment; N or N mm) cancels, and a row where
+  // the structure's terms cancel to rounding (~10 eps of that sum) is told from one a spring holds (its k r does
+  // not cancel) however stiff the rest of the model is. Against the whole |K| |R| instead, the stiff rows of a fine
+  // mesh (12 E I / L^3 grows as the elements shrink) set the level, and a 3 Hz suspension of a 100-element bar
+  // passed for free.
+  const Eigen::VectorXd sum = Ya.rowwise().sum();
+  for (Eigen::Index i = 0; i < Y.rows(); ++i) {
+    const double w = sum[i] > 0 ? 1.0 / sum[i] : 0.0;
+    Y.row(i) *= w;
+    Ya.row(i) *= w;
+  }
+  constexpr double tol = 1e-12;
   const double scale = Ya.norm() / std::sqrt(static_cast<double>(nc));
   // The motions may be dependent on the free DOFs (a tiny model: fewer free DOFs than motions), so work in an
   // orthonormal basis Q = R W of their span (W = V_r / s_r from the SVD of R; rank by rounding level), and

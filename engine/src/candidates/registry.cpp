@@ -191,7 +191,7 @@ Eigen::Vector3d default_gravity(const Model& model, bool* unconventional) {
   const int extended = (ext.array() > 0).count();
   auto at_bottom = [&](int a) { return ext[a] > 0 && shi[a] - lo[a] <= 0.01 * ext[a]; };
   if (!shi.allFinite() || extended < 2 || at_bottom(2) || !at_bottom(1)) return Eigen::Vector3d(0, 0, -1);
-  if (unconventional) *unconventional = true;
+  if (unconventional) *unconventional = ext[2] > 0;  // a space model flat in x-y (a plane frame) has y up: no doubt
   return Eigen::Vector3d(0, -1, 0);
 }
 
