@@ -225,7 +225,7 @@ class Evaluator {
       // Deflate the rigid-body motions only while K leaves them free (to rounding); else K - sigma M may be
       // singular at the automatic shift, and the motions are low elastic modes on their springs.
       // Free: the motions' highest eigenvalue on K (their Rayleigh quotients, R^T K R against R^T M R) is zero by
-      // EigenOptions::rigid_eigenvalue_tolerance, a test that does not depend on the units of the DOFs.
+      // the solvers' own test (rigid_eigenvalue_limit), which does not depend on the units of the DOFs.
       const Eigen::Index nr = rigid_basis_.cols();
       Eigen::MatrixXd KR(rigid_basis_.rows(), nr), MR(rigid_basis_.rows(), nr);
       for (Eigen::Index c = 0; c < nr; ++c) {
@@ -235,11 +235,9 @@ class Evaluator {
       const Eigen::MatrixXd A = rigid_basis_.transpose() * KR, B = rigid_basis_.transpose() * MR;
       const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(
           0.5 * (A + A.transpose()), 0.5 * (B + B.transpose()), Eigen::EigenvaluesOnly);
-      double kmax = 0;
-      for (Eigen::Index i = 0; i < K.rows(); ++i)
-        if (M.coeff(i, i) > 0) kmax = std::max(kmax, std::abs(K.coeff(i, i)) / M.coeff(i, i));
-      const bool free = es.info() == Eigen::Success &&
-                        es.eigenvalues().maxCoeff() <= solver_.options().rigid_eigenvalue_tolerance * kmax;
+      const bool free =
+          es.info() == Eigen::Success &&
+          es.eigenvalues().maxCoeff() <= rigid_eigenvalue_limit(K.diagonal(), M.diagonal(), solver_.options());
       solver_.options().rigid_body_basis = free ? rigid_basis_ : Eigen::MatrixXd();
       solver_.options().allow_singular_stiffness = !free;
     }

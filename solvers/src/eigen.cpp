@@ -344,6 +344,11 @@ void refine_eigenpairs(const SparseMatrix& K, const SparseMatrix& M, Eigen::Vect
   }
 }
 
+double rigid_eigenvalue_limit(const Eigen::VectorXd& k_diagonal, const Eigen::VectorXd& m_diagonal,
+                              const EigenOptions& options) {
+  return options.rigid_eigenvalue_tolerance * max_stiffness_to_mass(k_diagonal, m_diagonal);
+}
+
 double eigen_residual(const SparseMatrix& K, const SparseMatrix& M, double lambda, const Eigen::VectorXd& phi) {
   const Eigen::Index n = phi.size();
   Eigen::VectorXd kp(n), mp(n);
@@ -661,7 +666,7 @@ EigenSolution EigenSolver::solve(const SparseMatrix& K, const SparseMatrix& M) {
   // Without a rigid basis, zero-energy modes of a singular K are recognised by their eigenvalue (EigenOptions).
   const double nK = norm1(Ku), nM = norm1(Mu);
   if (r == 0 && sigma < 0 && opt.allow_singular_stiffness) {
-    const double zero = opt.rigid_eigenvalue_tolerance * max_stiffness_to_mass(kd, md);
+    const double zero = rigid_eigenvalue_limit(kd, md, opt);
     for (Eigen::Index k = 0; k < m; ++k)
       if (sol.eigenvalues[k] <= zero) sol.rigid_body[k] = 1;
     sum.num_rigid = static_cast<int>(std::count(sol.rigid_body.begin(), sol.rigid_body.end(), 1));
@@ -769,7 +774,7 @@ EigenSolution solve_eigen_dense(const Eigen::MatrixXd& K, const Eigen::MatrixXd&
   // (EigenOptions::rigid_eigenvalue_tolerance: the same test whatever the units of the DOFs).
   const Eigen::Index r = opt.rigid_body_basis.cols();
   const double nK = Ks.cwiseAbs().colwise().sum().maxCoeff(), nM = Ms.cwiseAbs().colwise().sum().maxCoeff();
-  const double zero = opt.rigid_eigenvalue_tolerance * max_stiffness_to_mass(Ks.diagonal(), Ms.diagonal());
+  const double zero = rigid_eigenvalue_limit(Ks.diagonal(), Ms.diagonal(), opt);
   std::vector<char> rigid(static_cast<std::size_t>(lam.size()), 0);
   for (Eigen::Index k = 0; k < lam.size(); ++k) rigid[k] = r > 0 ? k < r : lam[k] <= zero;
   std::vector<Eigen::Index> keep;

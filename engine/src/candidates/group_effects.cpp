@@ -1,5 +1,6 @@
 // axial_preload and distributed_mass: effects spread over all members or one element group (a tension or
 // compression the model leaves out; non-structural mass such as slabs, cladding, fittings).
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -183,7 +184,10 @@ std::vector<std::unique_ptr<Candidate>> per_group(const CandidateContext& c, con
 // preload then needs at least two supported nodes to react against, and acts on the group alone.
 class SelfStress {
  public:
-  explicit SelfStress(const Model& m) : m_(m) {
+  // support: the model's support restraints per node (CandidateContext::support).
+  SelfStress(const Model& m, const std::vector<DofMask>& support)
+      : m_(m),
+        supported_(static_cast<int>(std::count_if(support.begin(), support.end(), [](DofMask s) { return s != 0; }))) {
     if (m.free_free() || m.num_dofs() == 0) return;
     const AssembledSystem sys = assemble_system(m);
     factor_.emplace();
@@ -214,9 +218,7 @@ class SelfStress {
       free_elongation[static_cast<std::size_t>(e)] = std::move(u0);
     }
     if (!(restrained > 0)) {  // no axial DOFs
-      int supported = 0;
-      for (DofMask s : support_restraints(m_)) supported += s != 0;
-      return supported >= 2 ? std::optional<PreloadState>(alone) : std::nullopt;
+      return supported_ >= 2 ? std::optional<PreloadState>(alone) : std::nullopt;
     }
     if (!factor_) return alone;  // free-free or a mechanism: cannot say, keep the candidate
     Eigen::VectorXd u(f.size());
@@ -263,6 +265,7 @@ class SelfStress {
 
  private:
   const Model& m_;
+  int supported_;  // nodes with a support restraint
   std::optional<CholmodFactor> factor_;
 };
 
@@ -271,7 +274,7 @@ class SelfStress {
 CandidateKind axial_preload_kind() {
   return {"axial_preload", Nature::kStiffness, "an axial force (geometric stiffness) in all members or one group",
           [](const CandidateContext& c) {
-            const SelfStress self_stress(*c.model);
+            const SelfStress self_stress(*c.model, c.support);
             return per_group(c, [&](const std::string& g, std::vector<int> els) -> std::unique_ptr<Candidate> {
               std::optional<PreloadState> state = self_stress.preload(els);
               if (!state) return nullptr;

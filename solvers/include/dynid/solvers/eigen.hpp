@@ -139,6 +139,12 @@ class EigenSolver {
   EigenOptions options_;
 };
 
+/// The eigenvalue at or below which a mode is a rigid-body motion: options.rigid_eigenvalue_tolerance times
+/// max_i |K_ii| / M_ii over M_ii > 0 (else max |K_ii|, else 1), from the diagonals of K and M. The solvers' own
+/// test; callers that must decide as they do (is a model still free?) use it too.
+double rigid_eigenvalue_limit(const Eigen::VectorXd& k_diagonal, const Eigen::VectorXd& m_diagonal,
+                              const EigenOptions& options);
+
 /// Dense reference path (O(n^3)); the same options and result conventions.
 EigenSolution solve_eigen_dense(const Eigen::MatrixXd& K, const Eigen::MatrixXd& M, const EigenOptions& options);
 
