@@ -4,12 +4,12 @@
   heldout.py [--results DIR] [--out PNG]
 
 Reads the "all" rows of every held-out table in results/ (test, ci-rest, test2, test3, ...; not dev, which is
-tuned on) and prints, per acceptance rate, each set's count with its 95 % Wilson interval, the pooled rate, and
+tuned on) and prints, per acceptance rate, each set's count, the pooled rate with its 95 % Wilson interval, and
 whether the sets' spread is larger than their binomial sampling noise (chi-square test of homogeneity over the
-sets); writes a figure of the same (default results/heldout.png). Named-right and null counts are exact (from each
-table's list of the cases not right); parameters within 10 % are read from the rounded rate (marked ~, within one
-case per set). Each set was run at the commit its table names:
-the sets measure several heads, so a spread beyond sampling noise can be a rule's effect as well as the draw's.
+sets); writes a figure of the same with each set's 95 % Wilson interval (default results/heldout.png). Named-right
+and null counts are exact (from each table's list of the cases not right); parameters within 10 % are read from the
+rounded rate (marked ~, within one case per set). Each set was run at the commit its table names: the sets measure
+several heads, so a spread beyond sampling noise can be a rule's effect as well as the draw's.
 """
 import argparse
 import math
