@@ -54,13 +54,13 @@ def all_rows(path):
 
 
 def count(cell, path):
-    """'90 % (181)' -> (hits, n, exact): the table rounds rates to a whole percent, so hits is the count nearest
-    to it (within one for n < 200); exact is False."""
+    """'90 % (181)' -> (hits, n): the table rounds rates to a whole percent, so hits is the count nearest to it
+    (within one for n < 200)."""
     m = re.fullmatch(r"(\d+(?:\.\d+)?) % \((\d+)\)", cell)
     if not m:
         sys.exit(f"{path}: cannot read a rate from '{cell}' (expected 'P % (N)')")
     n = int(m.group(2))
-    return round(float(m.group(1)) / 100 * n), n, False
+    return round(float(m.group(1)) / 100 * n), n
 
 
 def misses(path):
@@ -80,13 +80,14 @@ def misses(path):
     return out
 
 
-def exact(rows, path, row, col):
-    """(hits, n, exact) of a rate: named right and nulls counted from the cases not right, others rounded."""
-    k, n, _ = count(rows[row][col], path)
+def exact(rows, missed, path, row, col):
+    """(hits, n, exact) of a rate from a table's rows and misses (all_rows, misses): named right and nulls counted
+    from the cases not right, others from the rounded rate."""
+    k, n = count(rows[row][col], path)
     if col == 3 and row in ("modal", "recordings"):
-        return n - misses(path)["modal" if row == "modal" else "rec"], n, True
+        return n - missed["modal" if row == "modal" else "rec"], n, True
     if col == 6:
-        return n - misses(path)["null"], n, True
+        return n - missed["null"], n, True
     return k, n, False
 
 
@@ -119,13 +120,13 @@ def main():
     sets = held_out_sets(a.results)
     if not sets:
         sys.exit(f"{a.results}: no held-out tables (test*/table.md, ci-rest/table.md)")
-    table = {name: all_rows(path) for name, path in sets}
+    table = {name: (all_rows(path), misses(path)) for name, path in sets}  # each file read once per part
     summary = []
     print("| rate | " + " | ".join(n for n, _ in sets) +
           " | pooled (95 % interval) | spread beyond sampling (p) | goal |")
     print("|---|" + "---|" * (len(sets) + 3))
     for label, row, col, goal in RATES:
-        rated = [exact(table[n], p, row, col) for n, p in sets]
+        rated = [exact(*table[n], p, row, col) for n, p in sets]
         counts = [(k, n) for k, n, _ in rated]
         approx = "" if all(e for _, _, e in rated) else "~"
         K, N = sum(k for k, _ in counts), sum(n for _, n in counts)

@@ -56,13 +56,14 @@ def main():
             f.write(table("0 % (5)", "0 % (5)", "0 % (5)", "0 % (2)", []))
         sets = heldout.held_out_sets(d)
         ok &= check("held-out sets in drawing order, dev left out", [n for n, _ in sets] == ["test", "test2"])
-        rows = heldout.all_rows(sets[0][1])
+        path = sets[0][1]
+        rows, missed = heldout.all_rows(path), heldout.misses(path)
         ok &= check("named right counted from the cases not right (9 of 11, not the rounded 10)",
-                    heldout.exact(rows, sets[0][1], "modal", 3) == (9, 11, True))
-        ok &= check("recordings: 2 of 4", heldout.exact(rows, sets[0][1], "recordings", 3) == (2, 4, True))
-        ok &= check("nulls: 1 of 2", heldout.exact(rows, sets[0][1], "both", 6) == (1, 2, True))
+                    heldout.exact(rows, missed, path, "modal", 3) == (9, 11, True))
+        ok &= check("recordings: 2 of 4", heldout.exact(rows, missed, path, "recordings", 3) == (2, 4, True))
+        ok &= check("nulls: 1 of 2", heldout.exact(rows, missed, path, "both", 6) == (1, 2, True))
         ok &= check("parameters from the rounded rate, marked inexact",
-                    heldout.exact(rows, sets[0][1], "both", 4) == (8, 10, False))
+                    heldout.exact(rows, missed, path, "both", 4) == (8, 10, False))
         out = subprocess.run([sys.executable, str(HERE / "heldout.py"), "--results", d, "--out",
                               os.path.join(d, "h.png")], capture_output=True, text=True)
         ok &= check("the command prints the pooled rates and writes the figure",
