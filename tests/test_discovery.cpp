@@ -156,6 +156,37 @@ TEST(Discovery, FlexibleBaseMatchesAnExplicitSpring) {
   EXPECT_EQ(s.findings.size(), 1u) << said(s);
 }
 
+// The chi-square tests are omnibus: the flexible base's misfit, spread over six modes at a stated noise that puts
+// the frequencies' chi-square at 20 (the 1 - 5e-4 quantile of chi-square with 6 degrees of freedom is 26.1, so the
+// tests alone call the model consistent; shapes at 20 % noise, far inside theirs), is removed by one parameter of
+// one candidate, whose evidence is decisive (ln B 9.1) and which lowers the frequencies' chi-square by more than
+// 2 x decisive (by 20). The data are then not consistent with the model: the spring is named. Before, the verdict
+// was "consistent" (dev-326: 90 % damage in one element, chi-square 23.3 for 6 modes). The bundled frame-null case
+// (cli.discover_frame-null) is the other side: a local candidate there lowers only the shapes' chi-square.
+TEST(Discovery, OneDecisiveCandidateOutweighsTheOmnibusTest) {
+  const Model analysis = make_frame2d(portal());
+  const ModalData meas = exact_modes(portal_on_base_spring(6.0e6), analysis, 6);
+  EigenOptions eo;
+  eo.num_modes = 6;
+  eo.method = EigenOptions::Method::kDense;
+  const ModalResult nominal = modal_analysis(analysis, eo);
+  ASSERT_TRUE(nominal.ok());
+  double sum = 0;  // chi-square of the relative frequency errors at unit noise
+  for (int k = 0; k < 6; ++k) {
+    const double f = nominal.frequencies_hz[k], g = meas.frequencies_hz[k];
+    sum += (f - g) * (f - g) / (g * g);
+  }
+  DiscoveryOptions o;
+  o.frequency_noise = std::sqrt(sum / 20.0);
+  o.shape_noise = 0.2;
+  const DiscoverySummary s = discover(analysis, meas, o);
+  ASSERT_LT(s.chi2_frequency_before * 6, 26.1) << "the omnibus test alone must pass here";
+  ASSERT_LT(s.chi2_shape_before, 1.0);
+  ASSERT_EQ(s.verdict, Verdict::kMissingPhysics) << said(s);
+  EXPECT_EQ(s.findings.at(0).kind, "flexible_support") << said(s);
+  EXPECT_EQ(s.findings.at(0).site.nodes, std::vector<int>{2}) << said(s);
+}
+
 // The same flexible base, stage by stage (engine/src/discovery/stages.hpp): what each stage hands the next. The
 // screen's linearised drop must already rank the spring at node 2 first among the local candidates (the data are
 // exact, so nothing but the physics orders them), the shortlist must keep it, its own fit must remove nearly all
