@@ -41,7 +41,8 @@ import uff                   # noqa: E402
 # "test7" (256256) was committed in session 64 (2026-12-02) before it was drawn: how much a held-out rate moves from
 # one fresh draw to the next at the same discovery as test6 (no rule changed between them).
 MASTER_SEED = {"dev": 1001, "ci": 2002, "test": 4004, "test2": 8008, "test3": 16016, "test4": 32032,
-               "test5": 64064, "test6": 128128, "test7": 256256}
+               "test5": 64064, "test6": 128128, "test7": 256256,
+               "test8": 512512}
 # Cases per truth kind in a split (half of each from modal data, half from recordings).
 KIND_COUNTS = {"attached_mass": 30, "sensor_mass": 30, "distributed_mass": 30, "joint_flexibility": 30,
                "support_flexibility": 30, "support_spring": 30, "damage": 30, "shear": 30, "preload": 30,
