@@ -1,5 +1,7 @@
 // Eigen-solvers: the sparse shift-invert Lanczos path against the dense path (1e-8 relative) on every model
 // small enough for the dense path; free-free structures, singular mass matrices, band mode, mechanisms.
+#include <cholmod.h>
+
 #include <Eigen/Dense>
 #include <random>
 
@@ -8,6 +10,7 @@
 #include "dynid/mesh/generators.hpp"
 #include "dynid/solvers/cholmod.hpp"
 #include "internal/lanczos.hpp"
+#include "internal/super_factor.hpp"
 #include "test_util.hpp"
 
 namespace dynid {
@@ -218,6 +221,103 @@ TEST(Eigen, TwoCoreSimplicialSolvesMatchCholmodForAnyThreadCount) {
     ASSERT_TRUE(G.factorize(other.K));
     EXPECT_FALSE(G.parallel_solves()) << other.K.rows();
   }
+}
+
+// The two-core supernodal factorization (super_factor.hpp) against CHOLMOD's own of the same symbolic factor, on a
+// 3D frame of 14 x 14 x 14 bays (20,250 DOFs; the factor CHOLMOD makes supernodal). Every entry of L within
+// 1e-13 of the largest (both are Cholesky factorizations of one matrix in one pattern and differ by the order of
+// the updates' sums: entry errors ~ n_updates eps |L|); bitwise the same L with one thread and with two (the split
+// depends on the factor alone); the solve's residual |K x - b| / |b| below 1e-8 (cond(K) eps). K - sigma M with
+// sigma between the 5th and 6th eigenvalues is not positive definite: the same failing column as CHOLMOD's (the
+// first in column order), and CholmodFactor reports it. Below pair.hpp's 20,000 rows CHOLMOD factors.
+TEST(Eigen, TwoCoreSupernodalFactorMatchesCholmodForAnyThreadCount) {
+  const Model m = make_frame3d(test::SteelFrame3D(14, 14, 14));
+  const AssembledSystem sys = assemble_system(m);
+  SparseMatrix K = sys.K;
+  K.makeCompressed();
+  ASSERT_GE(K.rows(), 20000);
+  cholmod_common c;
+  cholmod_start(&c);
+  c.print = 0;
+  c.error_handler = nullptr;
+  c.supernodal = CHOLMOD_SUPERNODAL;
+  c.final_ll = 1;
+  c.quick_return_if_not_posdef = 1;
+  auto view = [](const SparseMatrix& A) {
+    cholmod_sparse v{};
+    v.nrow = v.ncol = static_cast<size_t>(A.rows());
+    v.nzmax = static_cast<size_t>(A.nonZeros());
+    v.p = const_cast<int*>(A.outerIndexPtr());
+    v.i = const_cast<int*>(A.innerIndexPtr());
+    v.x = const_cast<double*>(A.valuePtr());
+    v.stype = 1;
+    v.itype = CHOLMOD_INT;
+    v.xtype = CHOLMOD_REAL;
+    v.dtype = CHOLMOD_DOUBLE;
+    v.sorted = v.packed = 1;
+    return v;
+  };
+  cholmod_sparse A = view(K);
+  cholmod_factor* ref = cholmod_analyze(&A, &c);
+  ASSERT_NE(ref, nullptr);
+  ASSERT_TRUE(ref->is_super);
+  cholmod_factor* mine = cholmod_copy_factor(ref, &c);
+  ASSERT_TRUE(cholmod_factorize(&A, ref, &c));
+  ASSERT_EQ(c.status, CHOLMOD_OK);
+  const auto [one, two] = test::OnOneThreadAndTwo([&] {
+    EXPECT_TRUE(detail::factorize_supernodal_pair(&A, mine, &c));
+    EXPECT_EQ(c.status, CHOLMOD_OK);
+    EXPECT_EQ(mine->minor, mine->n);
+    return Eigen::VectorXd(
+        Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(mine->x), static_cast<Eigen::Index>(mine->xsize)));
+  });
+  EXPECT_EQ((one - two).cwiseAbs().maxCoeff(), 0.0);
+  ASSERT_EQ(mine->xsize, ref->xsize);
+  const Eigen::Map<const Eigen::VectorXd> lref(static_cast<const double*>(ref->x),
+                                               static_cast<Eigen::Index>(ref->xsize));
+  EXPECT_LT((two - lref).cwiseAbs().maxCoeff(), 1e-13 * lref.cwiseAbs().maxCoeff());
+
+  CholmodFactor F;
+  F.analyze(K);
+  ASSERT_TRUE(F.factorize(K));
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Eigen::VectorXd b(K.rows()), x(K.rows());
+  for (Eigen::Index i = 0; i < b.size(); ++i) b[i] = u(rng);
+  F.solve(b.data(), x.data());
+  EXPECT_LT((K.selfadjointView<Eigen::Upper>() * x - b).norm(), 1e-8 * b.norm());
+
+  EigenOptions o;
+  o.num_modes = 6;
+  o.method = EigenOptions::Method::kSparse;
+  const ModalResult r = modal_analysis(m, sys, o);
+  ASSERT_TRUE(r.ok()) << r.summary.message;
+  const double sigma = 0.5 * (r.eigenvalues[4] + r.eigenvalues[5]);
+  SparseMatrix S = K - sigma * SparseMatrix(sys.M);
+  S.makeCompressed();
+  ASSERT_EQ(S.nonZeros(), K.nonZeros());  // M's pattern within K's: the analysed pattern
+  cholmod_sparse As = view(S);
+  cholmod_factorize(&As, ref, &c);
+  ASSERT_EQ(c.status, CHOLMOD_NOT_POSDEF);
+  const size_t minor = ref->minor;
+  ASSERT_TRUE(detail::factorize_supernodal_pair(&As, mine, &c));
+  EXPECT_EQ(c.status, CHOLMOD_NOT_POSDEF);
+  EXPECT_EQ(mine->minor, minor);
+  EXPECT_FALSE(F.factorize(S));
+  EXPECT_EQ(F.failed_index(), static_cast<const int*>(ref->Perm)[minor]);
+
+  cholmod_free_factor(&ref, &c);
+  cholmod_free_factor(&mine, &c);
+  cholmod_finish(&c);
+  const AssembledSystem small = assemble_system(make_frame3d(test::SteelFrame3D(6, 6, 6)));
+  ASSERT_LT(small.K.rows(), 20000);
+  cholmod_start(&c);
+  c.supernodal = CHOLMOD_SUPERNODAL;
+  cholmod_sparse As2 = view(small.K);
+  cholmod_factor* L2 = cholmod_analyze(&As2, &c);
+  EXPECT_FALSE(detail::factorize_supernodal_pair(&As2, L2, &c));
+  cholmod_free_factor(&L2, &c);
+  cholmod_finish(&c);
 }
 
 // The Lanczos steps' vector work on two row halves (LanczosOptions::pair_vectors): the same Ritz pairs, bitwise,

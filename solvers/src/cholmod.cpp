@@ -8,6 +8,7 @@
 
 #include "dynid/mesh/error.hpp"
 #include "internal/pair.hpp"
+#include "internal/super_factor.hpp"
 #include "internal/tree_solve.hpp"
 
 namespace dynid {
@@ -91,7 +92,9 @@ bool CholmodFactor::factorize(const SparseMatrix& A) {
   cholmod_sparse s = view(A);
   failed_ = -1;
   impl_->tree = detail::TreeSolve();  // it points into the factor's arrays, which the factorization may replace
-  const int ok = cholmod_factorize(&s, impl_->L, &c);
+  // Supernodal factors of kPairRows rows or more on two cores (super_factor.hpp), the others by CHOLMOD.
+  const int ok = detail::factorize_supernodal_pair(&s, impl_->L, &c) ? c.status >= CHOLMOD_OK
+                                                                     : cholmod_factorize(&s, impl_->L, &c);
   if (!ok && c.status != CHOLMOD_NOT_POSDEF)
     throw NumericalError("CHOLMOD factorization failed (status " + std::to_string(c.status) +
                          (c.status == CHOLMOD_OUT_OF_MEMORY ? ": out of memory" : "") + ")");

@@ -4,36 +4,34 @@
 #include <algorithm>
 
 #include "internal/pair.hpp"
+#include "internal/tree_split.hpp"
 
 namespace dynid::detail {
 
 namespace {
 
-// The split of the tree into kBins subtree sets and a top: starting from the roots, the heaviest subtree among the
-// candidates is moved to the top (its root, then its children become candidates) until the candidates' subtrees
-// pack into the sets (largest first, each into the lightest set) within kBalance of an even share, or until half
-// the work is in the top. Of the splits met on the way, the one with the least (largest set + top) work is kept.
+// split_tree's balance: the sets' subtrees within 3 % of an even share (tree_split.hpp).
 constexpr double kBalance = 1.03;
 
-// Largest-first packing of the candidates into kBins sets: the set of each candidate, and the largest load.
+// Largest-first packing of the candidates into kTreeBins sets: the set of each candidate, and the largest load.
 double pack(const std::vector<int>& cands, const std::vector<double>& W, std::vector<int>* bin_of) {
   std::vector<int> order(cands);
   std::stable_sort(order.begin(), order.end(),
                    [&](int a, int b) { return W[static_cast<std::size_t>(a)] > W[static_cast<std::size_t>(b)]; });
-  double load[TreeSolve::kBins] = {};
+  double load[kTreeBins] = {};
   for (int c : order) {
     int b = 0;
-    for (int k = 1; k < TreeSolve::kBins; ++k)
+    for (int k = 1; k < kTreeBins; ++k)
       if (load[k] < load[b]) b = k;
     load[b] += W[static_cast<std::size_t>(c)];
     if (bin_of) (*bin_of)[static_cast<std::size_t>(c)] = b;
   }
-  return *std::max_element(load, load + TreeSolve::kBins);
+  return *std::max_element(load, load + kTreeBins);
 }
 
-// Each node's set (0 .. kBins - 1) or -1 for the top, for a tree given by parent[] (parent after child, -1 at a
-// root) and each node's own work.
-std::vector<int> split_tree(const std::vector<int>& parent, const std::vector<double>& work) {
+}  // namespace
+
+std::vector<int> split_tree(const std::vector<int>& parent, const std::vector<double>& work, double top_share) {
   const int N = static_cast<int>(parent.size());
   std::vector<std::vector<int>> children(static_cast<std::size_t>(N));
   std::vector<double> W(work);
@@ -55,9 +53,9 @@ std::vector<int> split_tree(const std::vector<int>& parent, const std::vector<do
     double sum = 0;
     for (int c : cands) sum += W[static_cast<std::size_t>(c)];
     const double largest = pack(cands, W, nullptr);
-    if (best_cost < 0 || largest + top_work < best_cost)
-      best_cost = largest + top_work, best_cands = cands, best_top = top;
-    if (largest <= kBalance * sum / TreeSolve::kBins || top_work > 0.5 * total || cands.empty()) break;
+    if (best_cost < 0 || largest + top_share * top_work < best_cost)
+      best_cost = largest + top_share * top_work, best_cands = cands, best_top = top;
+    if (largest <= kBalance * sum / kTreeBins || top_work > 0.5 * total || cands.empty()) break;
     auto h = std::max_element(cands.begin(), cands.end(), [&](int a, int b) {
       return W[static_cast<std::size_t>(a)] < W[static_cast<std::size_t>(b)];
     });
@@ -76,8 +74,6 @@ std::vector<int> split_tree(const std::vector<int>& parent, const std::vector<do
       bin[static_cast<std::size_t>(k)] = bin[static_cast<std::size_t>(parent[static_cast<std::size_t>(k)])];
   return bin;
 }
-
-}  // namespace
 
 TreeSolve::TreeSolve(const cholmod_factor* L) {
   if (!L || !L->is_ll || L->is_super || L->xtype != CHOLMOD_REAL || L->dtype != CHOLMOD_DOUBLE ||

@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "internal/tree_split.hpp"
+
 namespace dynid::detail {
 
 /// Forward (L y = b) and backward (L^T x = y) solves with a numeric simplicial CHOLMOD L L^T factor (the factor
@@ -29,7 +31,7 @@ namespace dynid::detail {
 /// the caller then uses CHOLMOD's solves.
 class TreeSolve {
  public:
-  static constexpr int kBins = 2;
+  static constexpr int kBins = kTreeBins;
 
   TreeSolve() = default;
   explicit TreeSolve(const cholmod_factor* L);
