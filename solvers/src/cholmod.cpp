@@ -9,6 +9,7 @@
 #include "dynid/mesh/error.hpp"
 #include "internal/pair.hpp"
 #include "internal/super_factor.hpp"
+#include "internal/super_solve.hpp"
 #include "internal/tree_solve.hpp"
 
 namespace dynid {
@@ -20,6 +21,7 @@ struct CholmodFactor::Impl {
   mutable cholmod_dense* Y = nullptr;
   mutable cholmod_dense* E = nullptr;
   detail::TreeSolve tree;           // simplicial L L^T solves of one right-hand side on two cores (tree_solve.hpp)
+  detail::SuperSolve super;         // supernodal ones (super_solve.hpp)
   mutable Eigen::VectorXd scratch;  // a copy of the right-hand side of those solves, for the permutations
   Impl() { cholmod_start(&c); }
   ~Impl() {
@@ -75,7 +77,8 @@ void CholmodFactor::analyze(const SparseMatrix& A) {
   if (A.rows() != A.cols()) throw InputError("CholmodFactor: matrix is not square");
   if (!A.isCompressed()) throw InputError("CholmodFactor: matrix must be compressed");
   cholmod_common& c = impl_->c;
-  impl_->tree = detail::TreeSolve();  // it points into the factor freed here
+  impl_->tree = detail::TreeSolve();  // they point into the factor freed here
+  impl_->super = detail::SuperSolve();
   if (impl_->L) cholmod_free_factor(&impl_->L, &c);
   n_ = static_cast<int>(A.rows());
   cholmod_sparse s = view(A);
@@ -91,7 +94,8 @@ bool CholmodFactor::factorize(const SparseMatrix& A) {
   cholmod_common& c = impl_->c;
   cholmod_sparse s = view(A);
   failed_ = -1;
-  impl_->tree = detail::TreeSolve();  // it points into the factor's arrays, which the factorization may replace
+  impl_->tree = detail::TreeSolve();  // they point into the factor's arrays, which the factorization may replace
+  impl_->super = detail::SuperSolve();
   // Supernodal factors of kPairRows rows or more on two cores (super_factor.hpp), the others by CHOLMOD.
   const int ok = detail::factorize_supernodal_pair(&s, impl_->L, &c) ? c.status >= CHOLMOD_OK
                                                                      : cholmod_factorize(&s, impl_->L, &c);
@@ -104,8 +108,13 @@ bool CholmodFactor::factorize(const SparseMatrix& A) {
     failed_ = L->Perm ? static_cast<int*>(L->Perm)[k] : static_cast<int>(k);
     return false;
   }
-  // Two-core solves for large simplicial factors (tree_solve.hpp); CHOLMOD's own below pair.hpp's kPairRows.
-  if (kind_ == Kind::kSupernodalLLt && n_ >= detail::kPairRows) impl_->tree = detail::TreeSolve(L);
+  // Two-core solves for large factors (tree_solve.hpp, super_solve.hpp); CHOLMOD's own below pair.hpp's kPairRows.
+  if (kind_ == Kind::kSupernodalLLt && n_ >= detail::kPairRows) {
+    if (L->is_super)
+      impl_->super = detail::SuperSolve(L);
+    else
+      impl_->tree = detail::TreeSolve(L);
+  }
   return true;
 }
 
@@ -127,14 +136,14 @@ void CholmodFactor::solve_sys(int sys, const double* b, double* x, int ncol) con
 }
 
 void CholmodFactor::solve(const double* b, double* x) const {
-  if (!impl_->tree.ok()) return solve_sys(CHOLMOD_A, b, x);
+  if (!parallel_solves()) return solve_sys(CHOLMOD_A, b, x);
   forward(b, x);
   backward(x, x);
 }
 
 void CholmodFactor::forward(const double* b, double* x) const {
   if (kind_ != Kind::kSupernodalLLt) throw InternalError("CholmodFactor::forward needs an LL^T factor");
-  if (!impl_->tree.ok()) {
+  if (!parallel_solves()) {
     solve_sys(CHOLMOD_P, b, x);
     solve_sys(CHOLMOD_L, x, x);
     return;
@@ -146,12 +155,15 @@ void CholmodFactor::forward(const double* b, double* x) const {
     b = impl_->scratch.data();
   }
   for (int k = 0; k < n_; ++k) x[k] = b[perm ? perm[k] : k];
-  impl_->tree.forward(x);
+  if (impl_->super.ok())
+    impl_->super.forward(x);
+  else
+    impl_->tree.forward(x);
 }
 
 void CholmodFactor::backward(const double* b, double* x) const {
   if (kind_ != Kind::kSupernodalLLt) throw InternalError("CholmodFactor::backward needs an LL^T factor");
-  if (!impl_->tree.ok()) {
+  if (!parallel_solves()) {
     solve_sys(CHOLMOD_Lt, b, x);
     solve_sys(CHOLMOD_Pt, x, x);
     return;
@@ -160,7 +172,10 @@ void CholmodFactor::backward(const double* b, double* x) const {
   const int* perm = static_cast<const int*>(impl_->L->Perm);
   Eigen::VectorXd& y = impl_->scratch;
   y = Eigen::Map<const Eigen::VectorXd>(b, n_);
-  impl_->tree.backward(y.data());
+  if (impl_->super.ok())
+    impl_->super.backward(y.data());
+  else
+    impl_->tree.backward(y.data());
   for (int k = 0; k < n_; ++k) x[perm ? perm[k] : k] = y[k];
 }
 
@@ -191,7 +206,7 @@ int CholmodFactor::negative_pivots() const {
   return neg;
 }
 
-bool CholmodFactor::parallel_solves() const { return impl_->tree.ok(); }
+bool CholmodFactor::parallel_solves() const { return impl_->tree.ok() || impl_->super.ok(); }
 
 long long CholmodFactor::factor_nonzeros() const {
   const cholmod_common& c = impl_->c;

@@ -24,10 +24,9 @@ namespace dynid::detail {
 /// which adds the top rows' updates in another order. Consecutive columns that form a chain (each the next one's
 /// only child) are done four at a time, as CHOLMOD does, so that x at the rows below is read once per four.
 ///
-/// Supernodal factors are left to CHOLMOD: there the separator at the top holds a quarter of the entries (20x20x20
-/// frame), a dense block whose solve one thread cannot speed up, and the sets' gain did not cover it (measured:
-/// bench/README.md, "Two-core Lanczos steps"). ok() is false for them, and for any factor whose rows are not
-/// ascending below the diagonal or whose subtrees are not contiguous (CHOLMOD's postordered analysis gives both):
+/// Supernodal factors have their own two-core solves (super_solve.hpp, dense blocks). ok() is false for them, and
+/// for any factor whose rows are not ascending below the diagonal or whose subtrees are not contiguous (CHOLMOD's
+/// postordered analysis gives both):
 /// the caller then uses CHOLMOD's solves.
 class TreeSolve {
  public:

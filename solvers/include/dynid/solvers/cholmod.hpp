@@ -29,7 +29,8 @@ class CholmodFactor {
 
   /// Ordering and symbolic factorization for A's pattern.
   void analyze(const SparseMatrix& A);
-  /// Numeric factorization of A (A must have the analyzed pattern). Returns false on breakdown: LL^T of a matrix
+  /// Numeric factorization of A (A must have the analyzed pattern; a supernodal L L^T of at least 20,000 rows on two
+  /// cores: src/internal/super_factor.hpp). Returns false on breakdown: LL^T of a matrix
   /// that is not positive definite, or a zero pivot in LDL^T; failed_index() then names the (original) row.
   bool factorize(const SparseMatrix& A);
   /// x = A^{-1} b (b and x may alias).
@@ -46,8 +47,8 @@ class CholmodFactor {
   int failed_index() const { return failed_; }
   /// LDL^T only: the number of negative entries of D, i.e. the number of negative eigenvalues of A.
   int negative_pivots() const;
-  /// Whether forward(), backward() and solve() of one right-hand side run on two cores (a simplicial L L^T
-  /// factor: src/internal/tree_solve.hpp); otherwise they are CHOLMOD's own solves.
+  /// Whether forward(), backward() and solve() of one right-hand side run on two cores (an L L^T factor of at least
+  /// 20,000 rows: src/internal/tree_solve.hpp, super_solve.hpp); otherwise they are CHOLMOD's own solves.
   bool parallel_solves() const;
   long long factor_nonzeros() const;
   double factor_flops() const;  ///< floating point operations of the last numeric factorization
