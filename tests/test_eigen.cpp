@@ -322,6 +322,80 @@ TEST(Eigen, TwoCoreSupernodalFactorMatchesCholmodForAnyThreadCount) {
   cholmod_finish(&c);
 }
 
+// CHOLMOD's SuiteSparse_long routines (CholmodFactor::Indices::kLong; taken by themselves when a factor has 2^31
+// entries or more, which no test can afford: the 980,100-DOF 3D frame of bench/README.md) give the int routines'
+// results: the same ordering and the same arithmetic in the same order, so the solves agree bitwise (asserted to
+// 1e-15 of |x|, rounding's scale, in case a BLAS orders a sum differently). On the 14 x 14 x 14 frame (20,250 DOFs:
+// the two-core supernodal factorization and solves, super_factor.hpp, super_solve.hpp) and the 6 x 6 x 6 frame
+// (CHOLMOD's own factorization and solves; there also L D L^T with its inertia), K and K - sigma M with sigma above the
+// 5th eigenvalue, between two distinct ones (not positive definite: the same failing row and the same inertia).
+TEST(Eigen, LongIndicesGiveTheIntRoutinesResults) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (const int bays : {14, 6}) {
+    const Model m = make_frame3d(test::SteelFrame3D(bays, bays, bays));
+    const AssembledSystem sys = assemble_system(m);
+    SparseMatrix K = sys.K;
+    K.makeCompressed();
+    EigenOptions o;
+    o.num_modes = 10;
+    o.method = EigenOptions::Method::kSparse;
+    const ModalResult r = modal_analysis(m, sys, o);
+    ASSERT_TRUE(r.ok()) << r.summary.message;
+    int below = 5;  // sigma between two distinct eigenvalues (the square frames have pairs)
+    while (below < 9 && r.eigenvalues[below] < (1 + 1e-6) * r.eigenvalues[below - 1]) ++below;
+    ASSERT_LT(below, 9);
+    SparseMatrix S = K - 0.5 * (r.eigenvalues[below - 1] + r.eigenvalues[below]) * SparseMatrix(sys.M);
+    S.makeCompressed();
+    const Eigen::Index n = K.rows();
+    Eigen::MatrixXd B(n, 3);
+    for (Eigen::Index i = 0; i < B.size(); ++i) B.data()[i] = u(rng);
+    CholmodFactor fi, fl(CholmodFactor::Kind::kSupernodalLLt, CholmodFactor::Indices::kLong);
+    EXPECT_TRUE(fl.long_indices());
+    for (CholmodFactor* f : {&fi, &fl}) {
+      f->analyze(K);
+      ASSERT_TRUE(f->factorize(K));
+    }
+    EXPECT_FALSE(fi.long_indices());
+    EXPECT_EQ(fi.parallel_solves(), n >= 20000);
+    EXPECT_EQ(fl.parallel_solves(), fi.parallel_solves());
+    EXPECT_EQ(fl.factor_nonzeros(), fi.factor_nonzeros());
+    auto same = [](const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+      EXPECT_LE((a - b).cwiseAbs().maxCoeff(), 1e-15 * a.cwiseAbs().maxCoeff());
+    };
+    Eigen::VectorXd xi(n), xl(n);
+    fi.solve(B.col(0).data(), xi.data());
+    fl.solve(B.col(0).data(), xl.data());
+    same(xi, xl);
+    fi.forward(B.col(1).data(), xi.data());
+    fl.forward(B.col(1).data(), xl.data());
+    same(xi, xl);
+    fi.backward(B.col(2).data(), xi.data());
+    fl.backward(B.col(2).data(), xl.data());
+    same(xi, xl);
+    Eigen::MatrixXd Xi, Xl;
+    fi.solve_block(B, &Xi);
+    fl.solve_block(B, &Xl);
+    same(Xi, Xl);
+    EXPECT_FALSE(fi.factorize(S));
+    EXPECT_FALSE(fl.factorize(S));
+    EXPECT_GE(fi.failed_index(), 0);
+    EXPECT_EQ(fl.failed_index(), fi.failed_index());
+    if (n >= 20000) continue;  // a simplicial L D L^T of the large frame's fill takes seconds
+    CholmodFactor di(CholmodFactor::Kind::kSimplicialLDLt),
+        dl(CholmodFactor::Kind::kSimplicialLDLt, CholmodFactor::Indices::kLong);
+    for (CholmodFactor* f : {&di, &dl}) {
+      f->analyze(S);
+      ASSERT_TRUE(f->factorize(S));
+    }
+    EXPECT_EQ(di.negative_pivots(), below);
+    EXPECT_EQ(dl.negative_pivots(), below);
+    di.solve(B.col(0).data(), xi.data());
+    dl.solve(B.col(0).data(), xl.data());
+    same(xi, xl);
+  }
+}
+
 // The Lanczos steps' vector work on two row halves (LanczosOptions::pair_vectors): the same Ritz pairs, bitwise,
 // with one thread and with two, and the known eigenvalues (a diagonal operator of 30,000 rows) to the Lanczos
 // tolerance.

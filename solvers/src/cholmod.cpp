@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "dynid/mesh/error.hpp"
 #include "internal/pair.hpp"
@@ -14,8 +15,13 @@
 
 namespace dynid {
 
+// CHOLMOD's int routines, or its SuiteSparse_long ones (wide) once the int analysis has reported that the factor's
+// entries do not fit in an int (CHOLMOD_TOO_LARGE: 2^31 entries or more, e.g. a 3D frame of 10^6 DOFs): the
+// matrix's indices are then copied as SuiteSparse_long for each call, and the factor, the common and the solves'
+// workspaces are the long ones.
 struct CholmodFactor::Impl {
   cholmod_common c;
+  bool wide = false;
   cholmod_factor* L = nullptr;
   mutable cholmod_dense* X = nullptr;
   mutable cholmod_dense* Y = nullptr;
@@ -23,37 +29,81 @@ struct CholmodFactor::Impl {
   detail::TreeSolve tree;           // simplicial L L^T solves of one right-hand side on two cores (tree_solve.hpp)
   detail::SuperSolve super;         // supernodal ones (super_solve.hpp)
   mutable Eigen::VectorXd scratch;  // a copy of the right-hand side of those solves, for the permutations
+  std::vector<SuiteSparse_long> p, i;  // the matrix's indices as SuiteSparse_long (wide only, during a call)
   Impl() { cholmod_start(&c); }
-  ~Impl() {
-    if (L) cholmod_free_factor(&L, &c);
-    for (cholmod_dense** d : {&X, &Y, &E})
-      if (*d) cholmod_free_dense(d, &c);
-    cholmod_finish(&c);
+  ~Impl() { finish(); }
+  void finish() {
+    if (wide) {
+      if (L) cholmod_l_free_factor(&L, &c);
+      for (cholmod_dense** d : {&X, &Y, &E})
+        if (*d) cholmod_l_free_dense(d, &c);
+      cholmod_l_finish(&c);
+    } else {
+      if (L) cholmod_free_factor(&L, &c);
+      for (cholmod_dense** d : {&X, &Y, &E})
+        if (*d) cholmod_free_dense(d, &c);
+      cholmod_finish(&c);
+    }
+  }
+  // The same settings in a long common (the int one is finished, its factor and workspaces freed).
+  void widen() {
+    cholmod_common old = c;
+    finish();
+    wide = true;
+    cholmod_l_start(&c);
+    c.print = old.print;
+    c.error_handler = old.error_handler;
+    c.supernodal = old.supernodal;
+    c.final_ll = old.final_ll;
+    c.quick_return_if_not_posdef = old.quick_return_if_not_posdef;
+  }
+  // A read-only CHOLMOD view of an Eigen CSC matrix; stype = 1: only the upper triangle is used. Wide: its
+  // indices copied into p and i (valid until the next view).
+  cholmod_sparse view(const SparseMatrix& A) {
+    cholmod_sparse s;
+    std::memset(&s, 0, sizeof(s));
+    s.nrow = static_cast<size_t>(A.rows());
+    s.ncol = static_cast<size_t>(A.cols());
+    s.nzmax = static_cast<size_t>(A.nonZeros());
+    if (wide) {
+      p.assign(A.outerIndexPtr(), A.outerIndexPtr() + A.cols() + 1);
+      i.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
+      s.p = p.data();
+      s.i = i.data();
+      s.itype = CHOLMOD_LONG;
+    } else {
+      s.p = const_cast<int*>(A.outerIndexPtr());
+      s.i = const_cast<int*>(A.innerIndexPtr());
+      s.itype = CHOLMOD_INT;
+    }
+    s.x = const_cast<double*>(A.valuePtr());
+    s.stype = 1;
+    s.xtype = CHOLMOD_REAL;
+    s.dtype = CHOLMOD_DOUBLE;
+    s.sorted = 1;
+    s.packed = 1;
+    return s;
+  }
+  void release() {  // the long copies of the indices, after a call
+    p = {};
+    i = {};
+  }
+  // Entry k of an integer array of the factor (int or SuiteSparse_long).
+  long at(const void* a, size_t k) const {
+    return wide ? static_cast<long>(static_cast<const SuiteSparse_long*>(a)[k]) : static_cast<const int*>(a)[k];
   }
 };
 
 namespace {
-// A read-only CHOLMOD view of an Eigen CSC matrix; stype = 1: only the upper triangle is used.
-cholmod_sparse view(const SparseMatrix& A) {
-  cholmod_sparse s;
-  std::memset(&s, 0, sizeof(s));
-  s.nrow = static_cast<size_t>(A.rows());
-  s.ncol = static_cast<size_t>(A.cols());
-  s.nzmax = static_cast<size_t>(A.nonZeros());
-  s.p = const_cast<int*>(A.outerIndexPtr());
-  s.i = const_cast<int*>(A.innerIndexPtr());
-  s.x = const_cast<double*>(A.valuePtr());
-  s.stype = 1;
-  s.itype = CHOLMOD_INT;
-  s.xtype = CHOLMOD_REAL;
-  s.dtype = CHOLMOD_DOUBLE;
-  s.sorted = 1;
-  s.packed = 1;
-  return s;
+std::string status_text(const cholmod_common& c) {
+  std::string t = "status " + std::to_string(c.status);
+  if (c.status == CHOLMOD_OUT_OF_MEMORY) t += ": out of memory";
+  if (c.status == CHOLMOD_TOO_LARGE) t += ": the problem is too large for CHOLMOD's integers";
+  return t;
 }
 }  // namespace
 
-CholmodFactor::CholmodFactor(Kind kind) : impl_(std::make_unique<Impl>()), kind_(kind) {
+CholmodFactor::CholmodFactor(Kind kind, Indices indices) : impl_(std::make_unique<Impl>()), kind_(kind) {
   cholmod_common& c = impl_->c;
   c.print = 0;
   c.error_handler = nullptr;
@@ -69,6 +119,7 @@ CholmodFactor::CholmodFactor(Kind kind) : impl_(std::make_unique<Impl>()), kind_
     c.final_ll = 0;
   }
   c.quick_return_if_not_posdef = 1;
+  if (indices == Indices::kLong) impl_->widen();
 }
 
 CholmodFactor::~CholmodFactor() = default;
@@ -79,40 +130,58 @@ void CholmodFactor::analyze(const SparseMatrix& A) {
   cholmod_common& c = impl_->c;
   impl_->tree = detail::TreeSolve();  // they point into the factor freed here
   impl_->super = detail::SuperSolve();
-  if (impl_->L) cholmod_free_factor(&impl_->L, &c);
+  if (impl_->L) impl_->wide ? cholmod_l_free_factor(&impl_->L, &c) : cholmod_free_factor(&impl_->L, &c);
   n_ = static_cast<int>(A.rows());
-  cholmod_sparse s = view(A);
-  impl_->L = cholmod_analyze(&s, &c);
-  if (!impl_->L || c.status < CHOLMOD_OK)
-    throw NumericalError("CHOLMOD analysis failed (status " + std::to_string(c.status) +
-                         (c.status == CHOLMOD_OUT_OF_MEMORY ? ": out of memory" : "") + ")");
+  if (!impl_->wide) {
+    cholmod_sparse s = impl_->view(A);
+    impl_->L = cholmod_analyze(&s, &c);
+    if (c.status == CHOLMOD_TOO_LARGE) {
+      if (impl_->L) cholmod_free_factor(&impl_->L, &c);
+      impl_->widen();
+    }
+  }
+  if (impl_->wide) {
+    cholmod_sparse s = impl_->view(A);
+    impl_->L = cholmod_l_analyze(&s, &c);
+    impl_->release();
+  }
+  if (!impl_->L || c.status < CHOLMOD_OK) {
+    if (impl_->L) impl_->wide ? cholmod_l_free_factor(&impl_->L, &c) : cholmod_free_factor(&impl_->L, &c);
+    throw NumericalError("CHOLMOD analysis of a " + std::to_string(n_) + "-row matrix with " +
+                         std::to_string(A.nonZeros()) + " entries failed (" + status_text(c) + ")");
+  }
 }
 
 bool CholmodFactor::factorize(const SparseMatrix& A) {
   if (!impl_->L) throw InternalError("CholmodFactor::factorize called before analyze");
   if (A.rows() != n_) throw InputError("CholmodFactor: matrix size differs from the analyzed one");
   cholmod_common& c = impl_->c;
-  cholmod_sparse s = view(A);
+  cholmod_sparse s = impl_->view(A);
   failed_ = -1;
   impl_->tree = detail::TreeSolve();  // they point into the factor's arrays, which the factorization may replace
   impl_->super = detail::SuperSolve();
   // Supernodal factors of kPairRows rows or more on two cores (super_factor.hpp), the others by CHOLMOD.
-  const int ok = detail::factorize_supernodal_pair(&s, impl_->L, &c) ? c.status >= CHOLMOD_OK
-                                                                     : cholmod_factorize(&s, impl_->L, &c);
+  int ok = 0;
+  if (detail::factorize_supernodal_pair(&s, impl_->L, &c))
+    ok = c.status >= CHOLMOD_OK;
+  else
+    ok = impl_->wide ? cholmod_l_factorize(&s, impl_->L, &c) : cholmod_factorize(&s, impl_->L, &c);
+  impl_->release();
   if (!ok && c.status != CHOLMOD_NOT_POSDEF)
-    throw NumericalError("CHOLMOD factorization failed (status " + std::to_string(c.status) +
-                         (c.status == CHOLMOD_OUT_OF_MEMORY ? ": out of memory" : "") + ")");
+    throw NumericalError("CHOLMOD factorization of a " + std::to_string(n_) + "-row matrix failed (" + status_text(c) +
+                         ")");
   cholmod_factor* L = impl_->L;
   if (c.status == CHOLMOD_NOT_POSDEF || L->minor < L->n) {
     const size_t k = std::min<size_t>(L->minor, L->n - 1);
-    failed_ = L->Perm ? static_cast<int*>(L->Perm)[k] : static_cast<int>(k);
+    failed_ = static_cast<int>(L->Perm ? impl_->at(L->Perm, k) : static_cast<long>(k));
     return false;
   }
-  // Two-core solves for large factors (tree_solve.hpp, super_solve.hpp); CHOLMOD's own below pair.hpp's kPairRows.
+  // Two-core solves for large factors (tree_solve.hpp, super_solve.hpp); CHOLMOD's own below pair.hpp's kPairRows
+  // (and for simplicial factors with long indices, which tree_solve.hpp does not read).
   if (kind_ == Kind::kSupernodalLLt && n_ >= detail::kPairRows) {
     if (L->is_super)
       impl_->super = detail::SuperSolve(L);
-    else
+    else if (!impl_->wide)
       impl_->tree = detail::TreeSolve(L);
   }
   return true;
@@ -130,8 +199,10 @@ void CholmodFactor::solve_sys(int sys, const double* b, double* x, int ncol) con
   B.x = const_cast<double*>(b);
   B.xtype = CHOLMOD_REAL;
   B.dtype = CHOLMOD_DOUBLE;
-  if (!cholmod_solve2(sys, impl_->L, &B, nullptr, &impl_->X, nullptr, &impl_->Y, &impl_->E, &c))
-    throw NumericalError("CHOLMOD solve failed (status " + std::to_string(c.status) + ")");
+  const int ok = impl_->wide
+                     ? cholmod_l_solve2(sys, impl_->L, &B, nullptr, &impl_->X, nullptr, &impl_->Y, &impl_->E, &c)
+                     : cholmod_solve2(sys, impl_->L, &B, nullptr, &impl_->X, nullptr, &impl_->Y, &impl_->E, &c);
+  if (!ok) throw NumericalError("CHOLMOD solve failed (" + status_text(c) + ")");
   std::memcpy(x, impl_->X->x, sizeof(double) * static_cast<size_t>(n_) * static_cast<size_t>(ncol));
 }
 
@@ -149,12 +220,12 @@ void CholmodFactor::forward(const double* b, double* x) const {
     return;
   }
   // x = L^{-1} P b: (P b)[k] = b[Perm[k]], gathered into x and solved there (b copied first where it is x).
-  const int* perm = static_cast<const int*>(impl_->L->Perm);
+  const void* perm = impl_->L->Perm;
   if (b == x) {
     impl_->scratch = Eigen::Map<const Eigen::VectorXd>(b, n_);
     b = impl_->scratch.data();
   }
-  for (int k = 0; k < n_; ++k) x[k] = b[perm ? perm[k] : k];
+  for (int k = 0; k < n_; ++k) x[k] = b[perm ? impl_->at(perm, static_cast<size_t>(k)) : k];
   if (impl_->super.ok())
     impl_->super.forward(x);
   else
@@ -169,14 +240,14 @@ void CholmodFactor::backward(const double* b, double* x) const {
     return;
   }
   // x = P^T L^{-T} b: x[Perm[k]] = (L^{-T} b)[k].
-  const int* perm = static_cast<const int*>(impl_->L->Perm);
+  const void* perm = impl_->L->Perm;
   Eigen::VectorXd& y = impl_->scratch;
   y = Eigen::Map<const Eigen::VectorXd>(b, n_);
   if (impl_->super.ok())
     impl_->super.backward(y.data());
   else
     impl_->tree.backward(y.data());
-  for (int k = 0; k < n_; ++k) x[perm ? perm[k] : k] = y[k];
+  for (int k = 0; k < n_; ++k) x[perm ? impl_->at(perm, static_cast<size_t>(k)) : k] = y[k];
 }
 
 void CholmodFactor::solve_block(const Eigen::MatrixXd& B, Eigen::MatrixXd* X) const {
@@ -198,13 +269,14 @@ void CholmodFactor::backward_block(const Eigen::MatrixXd& B, Eigen::MatrixXd* X)
 int CholmodFactor::negative_pivots() const {
   const cholmod_factor* L = impl_->L;
   if (!L || L->is_ll || L->is_super) throw InternalError("negative_pivots needs a simplicial LDL^T factor");
-  const int* p = static_cast<const int*>(L->p);
   const double* x = static_cast<const double*>(L->x);
   int neg = 0;
   for (size_t j = 0; j < L->n; ++j)
-    if (x[p[j]] < 0) ++neg;
+    if (x[impl_->at(L->p, j)] < 0) ++neg;
   return neg;
 }
+
+bool CholmodFactor::long_indices() const { return impl_->wide; }
 
 bool CholmodFactor::parallel_solves() const { return impl_->tree.ok() || impl_->super.ok(); }
 

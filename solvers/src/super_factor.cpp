@@ -62,18 +62,21 @@ struct Scratch {
   int failed = -1;  // the first column (in L's order) whose pivot failed
 };
 
+// Int: the factor's and the matrix's index type (int, or SuiteSparse_long for factors of 2^31 entries or more).
+// Column and row numbers are below n and kept as int; positions in L's row lists and values as Index.
+template <typename Int>
 class Factorization {
  public:
   Factorization(const cholmod_sparse* S, cholmod_factor* L)
       : n_(static_cast<int>(L->n)),
         nsuper_(static_cast<int>(L->nsuper)),
-        super_(static_cast<const int*>(L->super)),
-        pi_(static_cast<const int*>(L->pi)),
-        px_(static_cast<const int*>(L->px)),
-        ls_(static_cast<const int*>(L->s)),
+        super_(static_cast<const Int*>(L->super)),
+        pi_(static_cast<const Int*>(L->pi)),
+        px_(static_cast<const Int*>(L->px)),
+        ls_(static_cast<const Int*>(L->s)),
         x_(static_cast<double*>(L->x)),
-        sp_(static_cast<const int*>(S->p)),
-        si_(static_cast<const int*>(S->i)),
+        sp_(static_cast<const Int*>(S->p)),
+        si_(static_cast<const Int*>(S->i)),
         sx_(static_cast<const double*>(S->x)) {}
 
   // Returns the first failing column, or -1.
@@ -81,15 +84,15 @@ class Factorization {
     const auto at = [](int k) { return static_cast<std::size_t>(k); };
     supermap_.resize(at(n_));
     for (int s = 0; s < nsuper_; ++s)
-      for (int k = super_[s]; k < super_[s + 1]; ++k) supermap_[at(k)] = s;
+      for (int k = col(s); k < col(s + 1); ++k) supermap_[at(k)] = s;
     std::vector<int> parent(at(nsuper_), -1);
     std::vector<double> work(at(nsuper_));
     int max_rows = 0;
     for (int s = 0; s < nsuper_; ++s) {
-      const double c = super_[s + 1] - super_[s], r = pi_[s + 1] - pi_[s] - c;
+      const double c = static_cast<double>(super_[s + 1] - super_[s]), r = static_cast<double>(rows(s)) - c;
       work[at(s)] = c * c * c / 3 + c * c * r + c * r * r;  // dpotrf, dtrsm, and its updates of its ancestors
-      if (r > 0) parent[at(s)] = supermap_[at(ls_[pi_[s] + super_[s + 1] - super_[s]])];
-      max_rows = std::max(max_rows, pi_[s + 1] - pi_[s]);
+      if (r > 0) parent[at(s)] = supermap_[at(row(pi_[s] + super_[s + 1] - super_[s]))];
+      max_rows = std::max(max_rows, rows(s));
     }
     const std::vector<int> bin = split_tree(parent, work, 0.5);  // the top's work is shared (factor_top)
     for (auto& h : head_) h.assign(at(nsuper_), -1);
@@ -114,23 +117,27 @@ class Factorization {
     // order is the one to report: a top supernode before it has all its descendants done (their columns are lower,
     // and each set stopped at its own first failure).
     for (int s : top) {
-      if (failed >= 0 && super_[s] >= failed) break;
+      if (failed >= 0 && col(s) >= failed) break;
       if (!factor_top(s, blas)) return failed >= 0 ? std::min(failed, scratch_[0].failed) : scratch_[0].failed;
     }
     return failed;
   }
 
  private:
+  int col(int s) const { return static_cast<int>(super_[s]); }             // supernode s's first column
+  int rows(int s) const { return static_cast<int>(pi_[s + 1] - pi_[s]); }  // its rows (its own columns first)
+  int row(Index p) const { return static_cast<int>(ls_[p]); }              // the row at position p of the row lists
+
   // Clears supernode s's block, maps its rows into w's map and scatters its columns of P A P^T (S: lower part).
   void assemble(int s, Scratch* w) {
-    const int k1 = super_[s], k2 = super_[s + 1], psi = pi_[s], nsrow = pi_[s + 1] - psi;
-    const Index psx = px_[s];
+    const int k1 = col(s), k2 = col(s + 1), nsrow = rows(s);
+    const Index psi = pi_[s], psx = px_[s];
     std::fill(x_ + psx, x_ + psx + static_cast<Index>(nsrow) * (k2 - k1), 0.0);
-    for (int k = 0; k < nsrow; ++k) w->map[static_cast<std::size_t>(ls_[psi + k])] = k;
+    for (int k = 0; k < nsrow; ++k) w->map[static_cast<std::size_t>(row(psi + k))] = k;
     for (int k = k1; k < k2; ++k) {
-      double* col = x_ + psx + static_cast<Index>(k - k1) * nsrow;
-      for (int p = sp_[k]; p < sp_[k + 1]; ++p)
-        if (si_[p] >= k) col[w->map[static_cast<std::size_t>(si_[p])]] = sx_[p];
+      double* c = x_ + psx + static_cast<Index>(k - k1) * nsrow;
+      for (Index p = sp_[k]; p < sp_[k + 1]; ++p)
+        if (si_[p] >= k) c[w->map[static_cast<std::size_t>(si_[p])]] = sx_[p];
     }
   }
 
@@ -138,15 +145,16 @@ class Factorization {
   // descendant d's pattern (rows in s's columns); map holds s's rows. By blocks of at most kBlock of those rows, so
   // that the workspace stays at kBlock columns (CHOLMOD's holds the largest update whole: 408 MB on the 249,900-DOF
   // frame).
-  void update(int s, int d, int r0, int r1, const std::vector<int>& map, Scratch* w) const {
-    const int pdi = pi_[d], pdend = pi_[d + 1], ndrow = pdend - pdi, ndcol = super_[d + 1] - super_[d];
-    const int nsrow = pi_[s + 1] - pi_[s];
+  void update(int s, int d, Index r0, Index r1, const std::vector<int>& map, Scratch* w) const {
+    const Index pdi = pi_[d], pdend = pi_[d + 1];
+    const int ndrow = rows(d), ndcol = col(d + 1) - col(d), nsrow = rows(s);
     const Index psx = px_[s];
     const double one = 1, zero = 0;
     int* rel = w->rel.data();
-    for (int i = r0; i < pdend; ++i) rel[i - r0] = map[static_cast<std::size_t>(ls_[i])];
-    for (int b0 = r0; b0 < r1; b0 += kBlock) {
-      const int n1 = std::min(kBlock, r1 - b0), n2 = pdend - b0, n3 = n2 - n1;
+    for (Index i = r0; i < pdend; ++i) rel[i - r0] = map[static_cast<std::size_t>(row(i))];
+    for (Index b0 = r0; b0 < r1; b0 += kBlock) {
+      const int n1 = static_cast<int>(std::min<Index>(kBlock, r1 - b0)), n2 = static_cast<int>(pdend - b0),
+                n3 = n2 - n1;
       const std::size_t size = static_cast<std::size_t>(n1) * static_cast<std::size_t>(n2);
       if (w->C.size() < size) w->C.resize(size);
       double* C = w->C.data();
@@ -155,27 +163,28 @@ class Factorization {
       if (n3 > 0) dgemm_("N", "T", &n3, &n1, &ndcol, &one, L1 + n1, &ndrow, L1, &ndrow, &zero, C + n1, &n2);
       const int* R = rel + (b0 - r0);
       for (int j = 0; j < n1; ++j) {
-        double* col = x_ + psx + static_cast<Index>(R[j]) * nsrow;
+        double* out = x_ + psx + static_cast<Index>(R[j]) * nsrow;
         const double* c = C + static_cast<Index>(n2) * j;
-        for (int i = j; i < n2; ++i) col[R[i]] -= c[i];
+        for (int i = j; i < n2; ++i) out[R[i]] -= c[i];
       }
     }
   }
 
   // The positions of descendant d's rows in s's columns: [lpos, end) of its pattern.
-  int rows_in(int s, int d) const {
-    const int end = pi_[d + 1], k2 = super_[s + 1];
-    int p = pi_[d] + lpos_[static_cast<std::size_t>(d)];
-    while (p < end && ls_[p] < k2) ++p;
+  Index rows_in(int s, int d) const {
+    const Index end = pi_[d + 1];
+    const int k2 = col(s + 1);
+    Index p = pi_[d] + lpos_[static_cast<std::size_t>(d)];
+    while (p < end && row(p) < k2) ++p;
     return p;
   }
 
   // After d has updated s (its rows up to position r1): on to the next supernode its rows reach, into list h.
-  void move_on(int d, int r1, std::vector<int>* h) {
+  void move_on(int d, Index r1, std::vector<int>* h) {
     const auto at = [](int k) { return static_cast<std::size_t>(k); };
-    lpos_[at(d)] = r1 - pi_[d];
+    lpos_[at(d)] = static_cast<int>(r1 - pi_[d]);
     if (r1 < pi_[d + 1]) {
-      const int a = supermap_[at(ls_[r1])];
+      const int a = supermap_[at(row(r1))];
       next_[at(d)] = (*h)[at(a)];
       (*h)[at(a)] = d;
     }
@@ -183,7 +192,7 @@ class Factorization {
 
   // dpotrf and dtrsm of supernode s's block, then s joins its parent's list h. False when a pivot fails.
   bool finish(int s, std::vector<int>* h, Scratch* w) {
-    const int k1 = super_[s], nscol = super_[s + 1] - k1, psi = pi_[s], nsrow = pi_[s + 1] - psi;
+    const int k1 = col(s), nscol = col(s + 1) - k1, nsrow = rows(s);
     double* Ls = x_ + px_[s];
     int info = 0;
     dpotrf_("L", &nscol, Ls, &nsrow, &info);
@@ -195,7 +204,7 @@ class Factorization {
     if (below > 0) {
       const double one = 1;
       dtrsm_("R", "L", "T", "N", &below, &nscol, &one, Ls, &nsrow, Ls + nscol, &nsrow);
-      const int a = supermap_[static_cast<std::size_t>(ls_[psi + nscol])];
+      const int a = supermap_[static_cast<std::size_t>(row(pi_[s] + nscol))];
       lpos_[static_cast<std::size_t>(s)] = nscol;
       next_[static_cast<std::size_t>(s)] = (*h)[static_cast<std::size_t>(a)];
       (*h)[static_cast<std::size_t>(a)] = s;
@@ -211,7 +220,7 @@ class Factorization {
       assemble(s, w);
       for (int d = (*h)[static_cast<std::size_t>(s)], dnext; d >= 0; d = dnext) {
         dnext = next_[static_cast<std::size_t>(d)];
-        const int r0 = pi_[d] + lpos_[static_cast<std::size_t>(d)], r1 = rows_in(s, d);
+        const Index r0 = pi_[d] + lpos_[static_cast<std::size_t>(d)], r1 = rows_in(s, d);
         update(s, d, r0, r1, w->map, w);
         move_on(d, r1, h);
       }
@@ -225,9 +234,10 @@ class Factorization {
     const auto at = [](int k) { return static_cast<std::size_t>(k); };
     Scratch* w0 = &scratch_[0];
     assemble(s, w0);
-    const int k1 = super_[s], nscol = super_[s + 1] - k1, nsrow = pi_[s + 1] - pi_[s];
+    const int k1 = col(s), nscol = col(s + 1) - k1, nsrow = rows(s);
     struct Pending {
-      int d, r0, mid, r1;
+      int d;
+      Index r0, mid, r1;
     };
     std::vector<Pending> pending;
     // The work of each column of s: its entries (the assembly and the scatter) and the products of the updates it
@@ -236,8 +246,10 @@ class Factorization {
     for (int j = 0; j < nscol; ++j) cost[at(j)] = nsrow - j;
     for (int list = 0; list <= kTreeBins; ++list)
       for (int d = head_[at(list)][at(s)]; d >= 0; d = next_[at(d)]) {
-        const int r0 = pi_[d] + lpos_[at(d)], r1 = rows_in(s, d), ndcol = super_[d + 1] - super_[d];
-        for (int q = r0; q < r1; ++q) cost[at(ls_[q] - k1)] += static_cast<double>(ndcol) * (pi_[d + 1] - q);
+        const Index r0 = pi_[d] + lpos_[at(d)], r1 = rows_in(s, d);
+        const int ndcol = col(d + 1) - col(d);
+        for (Index q = r0; q < r1; ++q)
+          cost[at(row(q) - k1)] += static_cast<double>(ndcol) * static_cast<double>(pi_[d + 1] - q);
         pending.push_back({d, r0, r0, r1});
       }
     // Columns below m to this core, the others to the helper: about half the work each.
@@ -246,7 +258,7 @@ class Factorization {
     int m = 0;
     for (double part = 0; m < nscol && part + cost[at(m)] <= 0.5 * total; ++m) part += cost[at(m)];
     for (Pending& q : pending)
-      while (q.mid < q.r1 && ls_[q.mid] < k1 + m) ++q.mid;
+      while (q.mid < q.r1 && row(q.mid) < k1 + m) ++q.mid;
     blas.one();
     run_pair(
         [&] {
@@ -264,9 +276,9 @@ class Factorization {
   }
 
   int n_, nsuper_;
-  const int *super_, *pi_, *px_, *ls_;
+  const Int *super_, *pi_, *px_, *ls_;
   double* x_;
-  const int *sp_, *si_;
+  const Int *sp_, *si_;
   const double* sx_;
   std::vector<int> supermap_, next_, lpos_;
   std::array<std::vector<int>, kTreeBins + 1> head_;  // descendants pending per supernode: each set's, the top's
@@ -275,30 +287,68 @@ class Factorization {
 
 }  // namespace
 
-bool factorize_supernodal_pair(cholmod_sparse* A, cholmod_factor* L, cholmod_common* c) {
-  if (!A || !L || !L->is_super || L->itype != CHOLMOD_INT || L->dtype != CHOLMOD_DOUBLE || A->itype != CHOLMOD_INT ||
-      A->xtype != CHOLMOD_REAL || A->dtype != CHOLMOD_DOUBLE || A->stype <= 0 || static_cast<long>(L->n) < kPairRows)
-    return false;
+namespace {
+
+// CHOLMOD's int or SuiteSparse_long routines for the factor's index type.
+template <typename Int>
+struct Api;
+template <>
+struct Api<int> {
+  static constexpr int itype = CHOLMOD_INT;
+  static int change_factor(cholmod_factor* L, cholmod_common* c) {
+    return cholmod_change_factor(CHOLMOD_REAL, true, true, true, true, L, c);
+  }
+  static cholmod_sparse* ptranspose(cholmod_sparse* A, void* perm, cholmod_common* c) {
+    return cholmod_ptranspose(A, 2, static_cast<int*>(perm), nullptr, 0, c);
+  }
+  static void free_sparse(cholmod_sparse** S, cholmod_common* c) { cholmod_free_sparse(S, c); }
+};
+template <>
+struct Api<SuiteSparse_long> {
+  static constexpr int itype = CHOLMOD_LONG;
+  static int change_factor(cholmod_factor* L, cholmod_common* c) {
+    return cholmod_l_change_factor(CHOLMOD_REAL, true, true, true, true, L, c);
+  }
+  static cholmod_sparse* ptranspose(cholmod_sparse* A, void* perm, cholmod_common* c) {
+    return cholmod_l_ptranspose(A, 2, static_cast<SuiteSparse_long*>(perm), nullptr, 0, c);
+  }
+  static void free_sparse(cholmod_sparse** S, cholmod_common* c) { cholmod_l_free_sparse(S, c); }
+};
+
+template <typename Int>
+bool factorize_pair(cholmod_sparse* A, cholmod_factor* L, cholmod_common* c) {
+  using F = Api<Int>;
   // L's numeric part, as cholmod_super_numeric allocates it.
-  if (L->xtype == CHOLMOD_PATTERN && !cholmod_change_factor(CHOLMOD_REAL, true, true, true, true, L, c)) return true;
+  if (L->xtype == CHOLMOD_PATTERN && !F::change_factor(L, c)) return true;
   if (L->xtype != CHOLMOD_REAL) return false;
   L->is_ll = true;
   // tril(P A P^T), as cholmod_factorize forms it for a matrix with its upper triangle stored.
-  cholmod_sparse* S = cholmod_ptranspose(A, 2, static_cast<int*>(L->Perm), nullptr, 0, c);
+  cholmod_sparse* S = F::ptranspose(A, L->Perm, c);
   if (!S) return true;  // c->status says why
   int failed = -1;
   try {
-    Factorization f(S, L);
+    Factorization<Int> f(S, L);
     failed = f.run();
   } catch (const std::bad_alloc&) {
-    cholmod_free_sparse(&S, c);
+    F::free_sparse(&S, c);
     c->status = CHOLMOD_OUT_OF_MEMORY;
     return true;
   }
-  cholmod_free_sparse(&S, c);
+  F::free_sparse(&S, c);
   c->status = failed >= 0 ? CHOLMOD_NOT_POSDEF : CHOLMOD_OK;
   L->minor = failed >= 0 ? static_cast<size_t>(failed) : L->n;
   return true;
+}
+
+}  // namespace
+
+bool factorize_supernodal_pair(cholmod_sparse* A, cholmod_factor* L, cholmod_common* c) {
+  if (!A || !L || !L->is_super || L->itype != A->itype || L->itype != c->itype || L->dtype != CHOLMOD_DOUBLE ||
+      A->xtype != CHOLMOD_REAL || A->dtype != CHOLMOD_DOUBLE || A->stype <= 0 || static_cast<long>(L->n) < kPairRows)
+    return false;
+  if (L->itype == CHOLMOD_INT) return factorize_pair<int>(A, L, c);
+  if (L->itype == CHOLMOD_LONG) return factorize_pair<SuiteSparse_long>(A, L, c);
+  return false;
 }
 
 }  // namespace dynid::detail

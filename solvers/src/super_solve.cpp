@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <limits>
 
 #include "internal/pair.hpp"
 #include "internal/tree_split.hpp"
@@ -19,19 +20,38 @@ using Block = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
 
 }  // namespace
 
+namespace {
+// A copy of CHOLMOD's index array a[0 .. n - 1] (int or SuiteSparse_long) as T; false if an entry does not fit.
+template <typename T>
+bool copy_index(const cholmod_factor* L, const void* a, std::size_t n, std::vector<T>* out) {
+  out->resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const long v = L->itype == CHOLMOD_INT ? static_cast<const int*>(a)[k] : static_cast<const SuiteSparse_long*>(a)[k];
+    if (v < std::numeric_limits<T>::min() || v > std::numeric_limits<T>::max()) return false;
+    (*out)[k] = static_cast<T>(v);
+  }
+  return true;
+}
+}  // namespace
+
 SuperSolve::SuperSolve(const cholmod_factor* L) {
   if (!L || !L->is_ll || !L->is_super || L->xtype != CHOLMOD_REAL || L->dtype != CHOLMOD_DOUBLE ||
-      L->itype != CHOLMOD_INT)
+      (L->itype != CHOLMOD_INT && L->itype != CHOLMOD_LONG) || !L->super || !L->pi || !L->px || !L->s || !L->x ||
+      L->nsuper < 1 || L->n > static_cast<std::size_t>(std::numeric_limits<int>::max()))
     return;
   n_ = static_cast<int>(L->n);
   const int nsuper = static_cast<int>(L->nsuper);
-  super_ = static_cast<const int*>(L->super);
-  pi_ = static_cast<const int*>(L->pi);
-  px_ = static_cast<const int*>(L->px);
-  ls_ = static_cast<const int*>(L->s);
-  x_ = static_cast<const double*>(L->x);
-  if (!super_ || !pi_ || !px_ || !ls_ || !x_ || nsuper < 1) return;
   const auto at = [](int k) { return static_cast<std::size_t>(k); };
+  if (!copy_index(L, L->super, at(nsuper) + 1, &super_) || !copy_index(L, L->pi, at(nsuper) + 1, &pi_) ||
+      !copy_index(L, L->px, at(nsuper) + 1, &px_))
+    return;
+  if (L->itype == CHOLMOD_INT) {
+    ls_ = static_cast<const int*>(L->s);
+  } else {
+    if (!copy_index(L, L->s, static_cast<std::size_t>(pi_[at(nsuper)]), &ls_own_)) return;
+    ls_ = ls_own_.data();
+  }
+  x_ = static_cast<const double*>(L->x);
   std::vector<int> supermap(at(n_));
   for (int s = 0; s < nsuper; ++s)
     for (int k = super_[s]; k < super_[s + 1]; ++k) supermap[at(k)] = s;

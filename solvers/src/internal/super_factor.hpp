@@ -21,11 +21,12 @@ namespace dynid::detail {
 /// alone and every update is added in a fixed order, so the result is the same with one thread or two; it equals
 /// CHOLMOD's to rounding (the updates of a top supernode are added in another order).
 ///
-/// Returns false, with L untouched, where it does not apply (a simplicial factor, other index or value types, fewer
-/// than kPairRows rows): the caller then uses cholmod_factorize. Otherwise true, with c->status CHOLMOD_OK and L a
-/// numeric supernodal L L^T factor that CHOLMOD's solves accept; CHOLMOD_NOT_POSDEF with L->minor at the column of
-/// the failing pivot (the one CHOLMOD would report: the first in column order); or CHOLMOD_OUT_OF_MEMORY.
-/// A is the matrix given to cholmod_analyze (stype 1: its upper triangle).
+/// Both of CHOLMOD's index types are accepted (int, and SuiteSparse_long for factors of 2^31 entries or more: A, L
+/// and c of the same type, as CHOLMOD requires). Returns false, with L untouched, where it does not apply (a
+/// simplicial factor, other value types, fewer than kPairRows rows): the caller then uses cholmod_factorize. Otherwise
+/// true, with c->status CHOLMOD_OK and L a numeric supernodal L L^T factor that CHOLMOD's solves accept;
+/// CHOLMOD_NOT_POSDEF with L->minor at the column of the failing pivot (the one CHOLMOD would report: the first in
+/// column order); or CHOLMOD_OUT_OF_MEMORY. A is the matrix given to cholmod_analyze (stype 1: its upper triangle).
 bool factorize_supernodal_pair(cholmod_sparse* A, cholmod_factor* L, cholmod_common* c);
 
 }  // namespace dynid::detail

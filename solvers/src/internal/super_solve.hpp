@@ -26,8 +26,8 @@ namespace dynid::detail {
 /// depends on the factor alone, so the result is the same with one thread or two; it differs from CHOLMOD's solve
 /// by rounding. The dense kernels are Eigen's: the work is memory-bound, and no BLAS threads share the cores.
 ///
-/// ok() is false for other factors (simplicial, other index or value types, rows not in CHOLMOD's supernodal
-/// layout): the caller then uses CHOLMOD's solves.
+/// Both of CHOLMOD's index types are accepted. ok() is false for other factors (simplicial, other value types, rows
+/// not in CHOLMOD's supernodal layout): the caller then uses CHOLMOD's solves.
 class SuperSolve {
  public:
   SuperSolve() = default;
@@ -46,8 +46,12 @@ class SuperSolve {
 
   bool ok_ = false;
   int n_ = 0;
-  // CHOLMOD's supernodes (first columns), row and value offsets, rows and values.
-  const int *super_ = nullptr, *pi_ = nullptr, *px_ = nullptr, *ls_ = nullptr;
+  // CHOLMOD's supernodes (first columns), row and value offsets (copied: nsuper + 1 entries each), rows (L's own,
+  // or a copy as int for a SuiteSparse_long factor) and values.
+  std::vector<int> super_, pi_;
+  std::vector<long> px_;
+  std::vector<int> ls_own_;
+  const int* ls_ = nullptr;
   const double* x_ = nullptr;
   std::vector<std::vector<int>> sets_;  // each set's supernodes, ascending
   std::vector<int> top_;                // the top's supernodes, ascending

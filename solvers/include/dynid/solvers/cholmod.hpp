@@ -22,7 +22,11 @@ class CholmodFactor {
                      ///< L, else simplicial; requires a positive definite matrix
     kSimplicialLDLt  ///< simplicial L D L^T; works for indefinite matrices and gives the inertia
   };
-  explicit CholmodFactor(Kind kind = Kind::kSupernodalLLt);
+  /// CHOLMOD's integer type: int, switching by itself to SuiteSparse_long when the analysis finds that the factor
+  /// would have 2^31 entries or more (kAuto); or SuiteSparse_long from the start (kLong: same results, more index
+  /// memory; for tests and for callers who know their factor is that large).
+  enum class Indices { kAuto, kLong };
+  explicit CholmodFactor(Kind kind = Kind::kSupernodalLLt, Indices indices = Indices::kAuto);
   ~CholmodFactor();
   CholmodFactor(const CholmodFactor&) = delete;
   CholmodFactor& operator=(const CholmodFactor&) = delete;
@@ -50,6 +54,8 @@ class CholmodFactor {
   /// Whether forward(), backward() and solve() of one right-hand side run on two cores (an L L^T factor of at least
   /// 20,000 rows: src/internal/tree_solve.hpp, super_solve.hpp); otherwise they are CHOLMOD's own solves.
   bool parallel_solves() const;
+  /// Whether CHOLMOD's SuiteSparse_long routines are in use (Indices::kLong, or a factor too large for int).
+  bool long_indices() const;
   long long factor_nonzeros() const;
   double factor_flops() const;  ///< floating point operations of the last numeric factorization
   int rows() const { return n_; }
