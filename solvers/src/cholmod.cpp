@@ -16,7 +16,7 @@
 namespace dynid {
 
 // CHOLMOD's int routines, or its SuiteSparse_long ones (wide) once the int analysis has reported that the factor's
-// entries do not fit in an int (CHOLMOD_TOO_LARGE: 2^31 entries or more, e.g. a 3D frame of 10^6 DOFs): the
+// storage does not fit in an int (CHOLMOD_TOO_LARGE: 2^31 stored values or more, e.g. a 3D frame of 10^6 DOFs): the
 // matrix's indices are then copied as SuiteSparse_long for each call, and the factor, the common and the solves'
 // workspaces are the long ones.
 struct CholmodFactor::Impl {

@@ -62,7 +62,7 @@ struct Scratch {
   int failed = -1;  // the first column (in L's order) whose pivot failed
 };
 
-// Int: the factor's and the matrix's index type (int, or SuiteSparse_long for factors of 2^31 entries or more).
+// Int: the factor's and the matrix's index type (int, or SuiteSparse_long for factors of 2^31 stored values or more).
 // Column and row numbers are below n and kept as int; positions in L's row lists and values as Index.
 template <typename Int>
 class Factorization {

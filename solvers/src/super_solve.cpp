@@ -18,9 +18,6 @@ constexpr int kSplitRows = 512;
 
 using Block = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
 
-}  // namespace
-
-namespace {
 // A copy of CHOLMOD's index array a[0 .. n - 1] (int or SuiteSparse_long) as T; false if an entry does not fit.
 template <typename T>
 bool copy_index(const cholmod_factor* L, const void* a, std::size_t n, std::vector<T>* out) {

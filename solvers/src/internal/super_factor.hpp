@@ -21,8 +21,8 @@ namespace dynid::detail {
 /// alone and every update is added in a fixed order, so the result is the same with one thread or two; it equals
 /// CHOLMOD's to rounding (the updates of a top supernode are added in another order).
 ///
-/// Both of CHOLMOD's index types are accepted (int, and SuiteSparse_long for factors of 2^31 entries or more: A, L
-/// and c of the same type, as CHOLMOD requires). Returns false, with L untouched, where it does not apply (a
+/// Both of CHOLMOD's index types are accepted (int, and SuiteSparse_long for factors of 2^31 stored values or more: A,
+/// L and c of the same type, as CHOLMOD requires). Returns false, with L untouched, where it does not apply (a
 /// simplicial factor, other value types, fewer than kPairRows rows): the caller then uses cholmod_factorize. Otherwise
 /// true, with c->status CHOLMOD_OK and L a numeric supernodal L L^T factor that CHOLMOD's solves accept;
 /// CHOLMOD_NOT_POSDEF with L->minor at the column of the failing pivot (the one CHOLMOD would report: the first in

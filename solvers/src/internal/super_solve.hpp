@@ -32,6 +32,10 @@ class SuperSolve {
  public:
   SuperSolve() = default;
   explicit SuperSolve(const cholmod_factor* L);
+  SuperSolve(const SuperSolve&) = delete;  // ls_ may point into ls_own_
+  SuperSolve& operator=(const SuperSolve&) = delete;
+  SuperSolve(SuperSolve&&) = default;
+  SuperSolve& operator=(SuperSolve&&) = default;
   bool ok() const { return ok_; }
   /// x <- L^{-1} x.
   void forward(double* x) const;

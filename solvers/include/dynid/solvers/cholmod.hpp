@@ -23,7 +23,7 @@ class CholmodFactor {
     kSimplicialLDLt  ///< simplicial L D L^T; works for indefinite matrices and gives the inertia
   };
   /// CHOLMOD's integer type: int, switching by itself to SuiteSparse_long when the analysis finds that the factor
-  /// would have 2^31 entries or more (kAuto); or SuiteSparse_long from the start (kLong: same results, more index
+  /// would store 2^31 values or more (kAuto); or SuiteSparse_long from the start (kLong: same results, more index
   /// memory; for tests and for callers who know their factor is that large).
   enum class Indices { kAuto, kLong };
   explicit CholmodFactor(Kind kind = Kind::kSupernodalLLt, Indices indices = Indices::kAuto);
