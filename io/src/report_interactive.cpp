@@ -305,11 +305,13 @@ const char* interactive_script() {
     var select = el.querySelector('select.mode'), play = el.querySelector('button.play'), amp = el.querySelector('input.amp');
     data.modes.forEach(function (m, i) { var o = document.createElement('option'); o.value = i; o.textContent = m.label; select.appendChild(o); });
     if (!data.modes.length) { note(el, 'No elastic mode to show.'); return; }
-    var running = true, phase = 0, last = null, snapshots = [];
+    var running = true, phase = 0, last = null, snapshots = [], snapshotSin = 0;
     play.onclick = function () { running = !running; play.textContent = running ? 'pause' : 'play'; };
     function draw(t) {
       if (last === null) last = t;
-      if (running) phase += (t - last) / 1000 * 2 * Math.PI / 1.6;
+      // A period of 1.6 s; one frame advances at most 0.1 s, so a slow renderer (software GL on a busy machine)
+      // shows a slower motion instead of an aliased one (frames a whole period apart would look still).
+      if (running) phase += Math.min(t - last, 100) / 1000 * 2 * Math.PI / 1.6;
       last = t;
       var u = data.modes[select.value || 0].u, a = amp.value * size * Math.sin(phase);
       for (var s = 0; s < data.segments.length; s++) {
@@ -321,10 +323,15 @@ const char* interactive_script() {
       renderer.render(scene, camera);
       frames++;
       if (frames % 10 === 0) body.setAttribute('data-frames', frames);
-      // For headless checks: two pictures a quarter period apart must differ (the shape moves).
-      if (frames === 5 || (snapshots.length === 1 && Math.abs(Math.sin(phase)) > 0.7)) {
+      // For headless checks: two pictures whose displacements differ by at least 0.7 of the amplitude (about a
+      // quarter period apart) must differ (the shape moves).
+      if (frames === 5 || (snapshots.length === 1 && Math.abs(Math.sin(phase) - snapshotSin) > 0.7)) {
+        snapshotSin = Math.sin(phase);
         snapshots.push(canvas.toDataURL());
-        if (snapshots.length === 2) body.setAttribute('data-frames-differ', snapshots[0] !== snapshots[1] ? 1 : 0);
+        if (snapshots.length === 2) {
+          body.setAttribute('data-frames-differ', snapshots[0] !== snapshots[1] ? 1 : 0);
+          body.setAttribute('data-snapshots', 'frame ' + frames + ', PNG sizes ' + snapshots[0].length + ' and ' + snapshots[1].length);
+        }
       }
       requestAnimationFrame(draw);
     }
