@@ -3,8 +3,9 @@
 on a pipe (Python's standard library only):
 
   - every zoomable plot drew (the page counts plots that rendered an SVG: data-plots-drawn = data-plots);
-  - every 3D mode-shape view animates: at least --frames frames rendered and two pictures whose displacements differ by
-    0.7 of the amplitude (about a quarter period apart) differ (data-frames, data-frames-differ), WebGL available (data-webgl = 1);
+  - every 3D mode-shape view animates: at least --frames frames rendered and two pictures whose displacements
+    differ by 0.7 of the amplitude (about a quarter period apart) differ (data-frames, data-frames-differ), WebGL
+    available (data-webgl = 1);
   - the page makes no network request: every request the browser reports (Network.requestWillBeSent) is to a
     file:, data: or blob: URL, and the page's Content-Security-Policy reported no violation.
 
@@ -117,8 +118,8 @@ def main():
         while time.time() < deadline:
             state = b.send("Runtime.evaluate", s, returnByValue=True, expression=(
                 "(function(){var d=document.body?document.body.dataset:{};return {plots:+d.plots||0,views:+d.views||0,"
-                "drawn:+d.plotsDrawn||0,frames:+d.frames||0,differ:d.framesDiffer,webgl:d.webgl,csp:+d.cspViolations||0,snapshots:d.snapshots,"
-                "ready:document.readyState};})()"))["result"].get("value", {})
+                "drawn:+d.plotsDrawn||0,frames:+d.frames||0,differ:d.framesDiffer,webgl:d.webgl,csp:+d.cspViolations||0,"
+                "snapshots:d.snapshots,ready:document.readyState};})()"))["result"].get("value", {})
             if (state.get("ready") == "complete" and state["drawn"] >= state["plots"] and
                     (state["views"] == 0 or (state["frames"] >= a.frames and state.get("differ") is not None))):
                 break
