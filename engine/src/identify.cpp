@@ -794,6 +794,7 @@ void sort_merged(IdentificationSummary& s, std::size_t bands, double flow, doubl
   for (StabilizationPole& p : s.poles)
     if (p.cluster >= 0) p.cluster = rank[static_cast<std::size_t>(p.cluster)];
   std::stable_sort(s.rejected.begin(), s.rejected.end(), by_f);
+  if (bands < 2) return;
   char b[200];
   std::snprintf(b, sizeof b, "%s in %zu sub-bands (each 1:%g%s): the band %.4g-%.4g Hz spans 1:%.0f", label, bands,
                 kSubBandSpan, how, flow, hi, hi / flow);
@@ -890,9 +891,13 @@ IdentificationSummary identify_lscf(const FrfData& frf_all, const Identification
   // A wide band with automatic orders: poles and selection per sub-band (the lowest modes of a wide band need
   // orders the strongest ones take), every sub-band giving the modes it owns; then LSFD over the whole band at
   // all of them. A sub-band too narrow for its orders (too few lines) leaves the whole band to one fit.
-  const std::vector<SubBand> bands =
-      o.max_order == 0 && in.lo > 0 ? sub_bands(in.lo, in.hi) : std::vector<SubBand>{{in.lo, in.hi, 0, 1e300}};
-  bool whole = bands.size() == 1;
+  // Lines below the band (lscf_fit_below) fix its lowest modes; the lowest sub-band then owns them from in.lo up.
+  const bool automatic = o.max_order == 0 && in.lo > 0;
+  const double below = automatic ? std::clamp(o.lscf_fit_below, 0.1, 1.0) : 1.0;
+  std::vector<SubBand> bands =
+      automatic ? sub_bands(below * in.lo, in.hi) : std::vector<SubBand>{{in.lo, in.hi, 0, 1e300}};
+  if (below < 1) bands.back().own_lo = in.lo;
+  bool whole = bands.size() == 1 && below == 1;
   if (!whole) {
     try {
       for (const SubBand& b : bands) {
@@ -905,6 +910,14 @@ IdentificationSummary identify_lscf(const FrfData& frf_all, const Identification
         merge_sub_band(s, t, b.own_lo, b.own_hi);
       }
       sort_merged(s, bands.size(), in.lo, in.hi, "LSCF", "");
+      if (below < 1) {
+        char b[200];
+        std::snprintf(b, sizeof b,
+                      "LSCF fitted from %.4g Hz, at most %.2g of the band's bottom (its lowest modes need lines below "
+                      "them); modes reported from %.4g Hz",
+                      bands.back().lo, below, in.lo);
+        s.notes.push_back(b);
+      }
     } catch (const InputError&) {
       s = lscf_head(frf_in, in, background);
       whole = true;
