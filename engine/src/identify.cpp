@@ -893,7 +893,7 @@ IdentificationSummary identify_lscf(const FrfData& frf_all, const Identification
   // all of them. A sub-band too narrow for its orders (too few lines) leaves the whole band to one fit.
   // Lines below the band (lscf_fit_below) fix its lowest modes; the lowest sub-band then owns them from in.lo up.
   const bool automatic = o.max_order == 0 && in.lo > 0;
-  const double below = automatic ? std::clamp(o.lscf_fit_below, 0.1, 1.0) : 1.0;
+  const double below = automatic && o.lscf_fit_below > 0 ? std::clamp(o.lscf_fit_below, 0.1, 1.0) : 1.0;
   std::vector<SubBand> bands =
       automatic ? sub_bands(below * in.lo, in.hi) : std::vector<SubBand>{{in.lo, in.hi, 0, 1e300}};
   if (below < 1) bands.back().own_lo = in.lo;

@@ -187,7 +187,7 @@ IdentificationSummary identify_once(const std::vector<Recording>& recs, const st
     fo.max_frequency_hz = std::min(1.25 * io.band_hi_hz, recs[0].sample_rate_hz / 2);
     IdentificationOptions o = io;
     // Impacts only: on Welch FRFs of continuous records it lost more lowest modes than it found (docs/method.md).
-    if (plan.impulsive) o.lscf_fit_below = 0.5;
+    if (plan.impulsive && o.lscf_fit_below == 0) o.lscf_fit_below = 0.5;
     return identify_lscf(estimate_frf(recs, fo), o);
   }
   Recording all = recs[0];

@@ -102,10 +102,10 @@ struct IdentificationOptions {
   int order_step = 0;                     ///< 0 = 1 (LSCF), 2 (SSI)
   int lscf_pole_budget = 0;               ///< > 0: automatic LSCF orders up to max(10, this / inputs) (0: kLscfOrders)
   /// Automatic LSCF orders: poles and selection from lines down to this fraction of the band's bottom (lower where
-  /// the lowest sub-band reaches lower), modes still reported from the bottom up (1 = the band itself).
-  /// identify_recordings sets 0.5 for impacts: a mode within about twice the bottom of the fitted lines is poorly fixed
-  /// (docs/method.md, "LSCF's lowest lines").
-  double lscf_fit_below = 1;
+  /// the lowest sub-band reaches lower), modes still reported from the bottom up (1 = the band itself). 0 = the
+  /// default: 0.5 for impacts in identify_recordings (a mode within about twice the bottom of the fitted lines is
+  /// poorly fixed; docs/method.md, "LSCF's lowest lines"), 1 otherwise.
+  double lscf_fit_below = 0;
   // Stability against the previous order (full weight within these, none beyond twice them).
   double stable_frequency = 0.01;   ///< relative frequency change
   double stable_damping = 0.05;     ///< relative damping change (the diagram's "stable in damping" mark)
