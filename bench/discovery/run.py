@@ -15,6 +15,7 @@ import multiprocessing
 import os
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -38,6 +39,25 @@ FLOORS = dict(modal_named_right=0.70, recordings_named_right=0.38, parameters_wi
               coverage=(0.25, 1.0), null_consistent=0.70, worsened=0)
 KIND_ORDER = list(generate.KIND_COUNTS)
 CANDIDATE = dict(ideal.CANDIDATE, null="consistent")   # each truth kind's own candidate, for the figure's order
+
+
+def regression_check(index, checks, prefix):
+    """One dev case as a regression check (test_expected_shape.py, test_lowest_mode.py; argv: DYNID [WORKDIR]):
+    generated, run and scored as the benchmark does (recordings kept, so that the case can be looked at); then
+    checks(score, truth, discover_json) returns the failures. Prints them; returns the exit code."""
+    dynid = sys.argv[1]
+    work = Path(sys.argv[2]) if len(sys.argv) > 2 else Path(tempfile.mkdtemp(prefix=prefix))
+    work.mkdir(parents=True, exist_ok=True)
+    sc = run_case((None, "dev", index, dict(out=str(work), dynid=dynid, timeout=120, keep=True)))
+    if sc["failure"]:
+        print(f"FAIL: {sc['failure']}")
+        return 1
+    folder = work / sc["case"]
+    failures = checks(sc, json.loads((folder / "truth.json").read_text()),
+                      json.loads((folder / "discover.json").read_text()))
+    for f in failures:
+        print("FAIL:", f)
+    return 1 if failures else 0
 
 
 def run_case(job):

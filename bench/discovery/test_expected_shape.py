@@ -9,25 +9,13 @@ Usage: test_expected_shape.py DYNID [WORKDIR]   (exit 0 when every check holds; 
 """
 import json
 import sys
-import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import run  # noqa: E402
 
 
-def main():
-    dynid = sys.argv[1]
-    work = Path(sys.argv[2]) if len(sys.argv) > 2 else Path(tempfile.mkdtemp(prefix="dynid-expected-"))
-    work.mkdir(parents=True, exist_ok=True)
-    # Generate, run dynid and score as the benchmark does (recordings kept, so that the case can be looked at).
-    sc = run.run_case((None, "dev", 187, dict(out=str(work), dynid=dynid, timeout=120, keep=True)))
-    if sc["failure"]:
-        print(f"FAIL: {sc['failure']}")
-        return 1
-    folder = work / sc["case"]
-    truth = json.loads((folder / "truth.json").read_text())
-    result = json.loads((folder / "discover.json").read_text())
+def checks(sc, truth, result):
     failures = []
     notes = [w for w in json.dumps(result).split('"') if "its shape complex when fitted beside the other modes" in w]
     print("notes:", notes)
@@ -42,10 +30,8 @@ def main():
     print("dynid said:", sc["said"])
     if not sc["named_right"]:
         failures.append("the preload is not named first")
-    for f in failures:
-        print("FAIL:", f)
-    return 1 if failures else 0
+    return failures
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run.regression_check(187, checks, "dynid-expected-"))

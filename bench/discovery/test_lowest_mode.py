@@ -8,26 +8,14 @@ shape matched the model's, and discovery named an attached mass of 577 kg.
 
 Usage: test_lowest_mode.py DYNID [WORKDIR]   (exit 0 when every check holds; ctest bench.discovery_lowest_mode)
 """
-import json
 import sys
-import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import run  # noqa: E402
 
 
-def main():
-    dynid = sys.argv[1]
-    work = Path(sys.argv[2]) if len(sys.argv) > 2 else Path(tempfile.mkdtemp(prefix="dynid-lowest-"))
-    work.mkdir(parents=True, exist_ok=True)
-    sc = run.run_case((None, "dev", 221, dict(out=str(work), dynid=dynid, timeout=120, keep=True)))
-    if sc["failure"]:
-        print(f"FAIL: {sc['failure']}")
-        return 1
-    folder = work / sc["case"]
-    truth = json.loads((folder / "truth.json").read_text())
-    result = json.loads((folder / "discover.json").read_text())
+def checks(sc, truth, result):
     failures = []
     f1 = min(m["frequency_hz"] for m in truth["modes"] if not m.get("suspension"))
     measured = [m["frequency_hz"] for m in result["measured"]["modes"]]
@@ -38,10 +26,8 @@ def main():
     print("dynid said:", sc["said"])
     if not sc["null_right"]:
         failures.append("the null case is not called consistent")
-    for f in failures:
-        print("FAIL:", f)
-    return 1 if failures else 0
+    return failures
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run.regression_check(221, checks, "dynid-lowest-"))
