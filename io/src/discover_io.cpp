@@ -155,6 +155,13 @@ std::string fit_words(const DiscoverySummary& s) {
          " %, mean MAC " + format_number(s.before.mean_mac, 4) + " -> " + format_number(s.after.mean_mac, 4);
 }
 
+// "1.2e+03 N/m ± 13 %": a value with its unit and its relative standard deviation.
+std::string value_words(const PhysicalValue& v) {
+  std::string w = format_number(v.value, 3) + (v.unit.empty() ? "" : " " + v.unit);
+  if (std::isfinite(v.std) && v.value != 0) w += " ± " + format_number(100.0 * std::abs(v.std / v.value), 2) + " %";
+  return w;
+}
+
 std::string findings_words(const DiscoverySummary& s) {
   std::string w;
   for (std::size_t k = 0; k < s.findings.size(); ++k) {
@@ -162,7 +169,11 @@ std::string findings_words(const DiscoverySummary& s) {
     w += (k ? "; and " : "") + h.finding;
     if (h.equivalent.empty()) continue;
     w += " (the data cannot tell this site from: ";
-    for (std::size_t q = 0; q < h.equivalent.size() && q < 4; ++q) w += (q ? "; " : "") + h.equivalent[q];
+    for (std::size_t q = 0; q < h.equivalent.size() && q < 4; ++q) {
+      w += (q ? "; " : "") + h.equivalent[q];
+      if (q < h.equivalent_values.size() && !h.equivalent_values[q].empty())
+        w += ", " + value_words(h.equivalent_values[q][0]);
+    }
     if (h.equivalent.size() > 4) w += "; and " + std::to_string(h.equivalent.size() - 4) + " more";
     w += ")";
   }
@@ -348,6 +359,10 @@ nlohmann::ordered_json discovery_json(const Case& c, const DiscoveryData& d, con
     f["units"] = units;
     f["description"] = h.finding;
     f["equivalent"] = h.equivalent;
+    nlohmann::ordered_json ev = nlohmann::ordered_json::array();
+    for (const std::vector<PhysicalValue>& v : h.equivalent_values)
+      ev.push_back({{"parameters", values_json(v, false)}, {"std", values_json(v, true)}});
+    f["equivalent_values"] = ev;
     f["importance"] = or_null(true, h.log_evidence);
     f["significance"] = h.significance;
     f["at_bound"] = h.at_bound;

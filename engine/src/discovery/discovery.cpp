@@ -295,6 +295,7 @@ Equivalents name_equivalent_sites(const Problem& p, const Selection& sel, const 
       equivalent[c].push_back(g.set[0]);
       ScoredHypothesis& h = S->findings[k];
       h.equivalent.push_back(g.set[0]->description());
+      h.equivalent_values.push_back(scored(p, g, 0).values);
       // A local finding's site grows by the equivalent sites; a global one (all members, or a group) keeps the
       // site its description names (another group is an equivalent story, not a larger site).
       if (c->global()) continue;

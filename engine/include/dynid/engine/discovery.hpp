@@ -133,6 +133,10 @@ struct ScoredHypothesis {
   /// Findings: the same kind at other sites the data cannot tell from this one (a local finding's `site` holds
   /// theirs too, after its own; a global one keeps its own).
   std::vector<std::string> equivalent;
+  /// Each equivalent site's own values (and standard deviations), fitted alone, in the order of `equivalent`: a
+  /// spring or a mass at another site needs another value to predict the same data, so `values` belong to the
+  /// first site only.
+  std::vector<std::vector<PhysicalValue>> equivalent_values;
   double max_freq_error_pct = 0, mean_mac = 0;
   bool at_bound = false;           ///< a parameter ended on a bound (the hypothesis strains to fit)
 };
