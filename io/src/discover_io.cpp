@@ -266,8 +266,12 @@ std::string localization_words(const DiscoverySummary& s) {
          where + "; " + pct(L.concentration) + " % in the top fifth of the measured nodes, mostly in " + dir + ". ";
   }
   w += std::string("The model is ") + (L.mean_frequency_error_pct > 0 ? "stiffer" : "softer") +
-       " than the data on average (mean frequency error " + format_number(L.mean_frequency_error_pct, 3) + " %); the mismatch is " +
-       to_string(L.nature) + "-like (residual alignment with inertia forces " + format_number(L.mass_alignment, 2) + ").";
+       " than the data on average (mean frequency error " + format_number(L.mean_frequency_error_pct, 3) +
+       " %); the local candidates that explain most of it change " +
+       (L.nature == Nature::kMass ? "mass" : "stiffness") + "; the residual forces align with the inertia forces by " +
+       format_number(L.mass_alignment, 2) +
+       " (1 for a change in proportion everywhere, such as a uniform E or density; lower for a local change the sensors"
+       " resolve).";
   return w;
 }
 

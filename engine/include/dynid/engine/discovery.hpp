@@ -107,7 +107,10 @@ struct Localization {
   double concentration = 0;        ///< share of the largest 20 % of nodes (1 = all in one spot)
   bool localized = false;          ///< three or more measured nodes and over half the share in the top fifth
   Eigen::Vector3d direction_share = Eigen::Vector3d::Zero();  ///< x, y, z shares of the residual
-  double mass_alignment = 0;       ///< mean over modes of |cos(R_k, lambda_k M~ u_k)|: ~1 mass-like, ~0 stiffness-like
+  /// Mean over modes of |cos(R_k, lambda_k M~ u_k)|: 1 when the model is off in proportion everywhere (a uniform
+  /// change of E or of rho: the residual is then the inertia force itself), small for a local change of either
+  /// nature. It does not tell mass from stiffness; `nature` does.
+  double mass_alignment = 0;
   double mean_frequency_error_pct = 0;  ///< mean (model - measured) / measured
   Nature nature = Nature::kStiffness;   ///< the nature of the candidates that explain most in the screening
 };
