@@ -11,6 +11,7 @@ run at a time. dynid's failures (exit code, last line of its error output) are s
 """
 import argparse
 import json
+import math
 import multiprocessing
 import os
 import subprocess
@@ -186,6 +187,35 @@ def pct(v):
     return "–" if v is None else f"{100 * v:.0f} %"
 
 
+def parameter_lines(cases):
+    """Parameters against what the data allow (a diagnosis): by the stated 1-sigma, how many are within 10 % and
+    how many a calibrated, unbiased estimate of that 1-sigma would put there; and against the candidate's own best
+    value on the truth's noise-free frequencies where the finding sits at its site (score.py, `ideal_site`)."""
+    par = [c for c in cases if c["named_right"] and not c.get("below_floor") and c.get("within") is not None]
+    if not par:
+        return []
+    lines = ["", "## Parameters against what the data allow", "",
+             "Cases named right with a reference, by the 1σ dynid states (relative to its value); `expected`: the "
+             "number within 10 % were every stated 1σ exact and every estimate unbiased (score.py `expected_within`).",
+             "", "| stated 1σ | cases | within 10 % | 1σ covers | expected within 10 % |", "|---|---|---|---|---|"]
+    def rel(c):
+        p = c["parameter"]
+        return abs(p["std"] / p["value"]) if p.get("std") is not None and p.get("value") else math.inf
+    for label, lo, hi in (("< 6 %", 0, 0.06), ("6–10 %", 0.06, 0.10), ("10–20 %", 0.10, 0.20), ("≥ 20 % or none", 0.20, math.inf)):
+        b = [c for c in par if lo <= rel(c) < hi or (hi == math.inf and rel(c) == math.inf)]
+        if b:
+            lines.append(f"| {label} | {len(b)} | {sum(c['within'] for c in b)} | {sum(bool(c.get('covered')) for c in b)} | "
+                         f"{sum(c.get('expected_within', 0.0) for c in b):.1f} |")
+    lines.append(f"| all | {len(par)} | {sum(c['within'] for c in par)} | {sum(bool(c.get('covered')) for c in par)} | "
+                 f"{sum(c.get('expected_within', 0.0) for c in par):.1f} |")
+    at = [c for c in par if c.get("within_ideal") is not None]
+    if at:
+        lines += ["", f"Against the candidate's own best value on the truth's noise-free frequencies (truth.json "
+                  f"`effects[].ideal`), for the {len(at)} findings at the ideal candidate's site: "
+                  f"{sum(c['within_ideal'] for c in at)} within 10 % (of the reference: {sum(c['within'] for c in at)})."]
+    return lines
+
+
 def table(rep, cases, checks, meta):
     rows = ["| truth kind | data | cases | named right | parameters within 10 % | 1σ coverage | nulls consistent | "
             "inconclusive | failed | median fit gain | worsened |", "|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -226,6 +256,8 @@ def table(rep, cases, checks, meta):
         if b:
             lines.append(f"| {lo:g}–{min(hi, 1):g} | {len(b)} | {pct(sum(c['probability'] for c in b) / len(b))} | "
                          f"{pct(sum(c['named_right'] for c in b) / len(b))} |")
+    lines += parameter_lines(cases)
+
     def truth_and_said(c, width):
         truth = "null" if c["null"] else "; ".join(c.get("truth_effects", [])) or c["kind"]
         return f"{c['kind']}: {truth}", c["said"].replace("|", "/").replace("\n", " ")[:width]

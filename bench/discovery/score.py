@@ -13,7 +13,10 @@ Rules (README.md):
 * for a case named right, the finding's parameter is compared with the reference the truth states for that
   kind (damage: the flexibility-equivalent change of the named element set; mass change of an element: the
   attached mass as a share of that element's mass): within 10 %, and whether the stated 1-sigma interval covers
-  the reference;
+  the reference; also (a diagnosis, not an acceptance rate) the parameter against the candidate's own best value
+  on the truth's noise-free frequencies (truth.json `effects[].ideal`, ideal.py), where the first finding sits at
+  the ideal candidate's site (`ideal_site`), and the chance a calibrated, unbiased estimate of the stated 1-sigma
+  lands within 10 % of the reference (`expected_within`: erf(0.1 |reference| / (sqrt 2 std)));
 * the fit block gives the before / after max frequency error and mean MAC; findings that raise the one (by more
   than 0.1 % of it) or lower the other (by more than 0.001) are flagged as worsening the fit;
 * a non-null case whose effects do not all shift the data's modes by the benchmark's lower bound (generate.py:
@@ -83,6 +86,30 @@ def reference_value(spec, finding, lengths):
     return 100 * (1 / (1 + flex) - 1)
 
 
+def ideal_site(finding, effect, reference):
+    """Whether the first finding sits where ideal.py put the effect's ideal candidate: the same kind; a global
+    candidate or an element set anywhere accepted; otherwise its own (first) site in the accepted nodes and
+    elements (a joint: its joint and its member end; a lumped mass only when one node is accepted, ideal.py taking
+    the accepted node nearest the block) and the ideal's reference the scored one (damage: the same elements)."""
+    ideal = effect.get("ideal")
+    if not ideal or ideal.get("candidate") != finding["kind"] or reference is None:
+        return False
+    if ideal.get("reference") is None or abs(ideal["reference"] - reference) > 1e-9 * abs(reference):
+        return False
+    acc = effect["accept"]
+    if acc.get("global") or "element_sets" in acc:
+        return True
+    loc = finding.get("location", {})
+    nodes, els = loc.get("nodes", [])[:1], loc.get("elements", [])[:1]
+    if finding["kind"] == "semi_rigid_joint":
+        return bool(nodes and els and nodes[0] in acc.get("nodes", []) and els[0] in acc.get("elements", []))
+    if finding["kind"] == "lumped_mass" and len(acc.get("nodes", [])) != 1:
+        return False
+    if finding["kind"] == "member_damage":
+        return True  # the same reference: the named elements are the ideal's
+    return bool(nodes and nodes[0] in acc.get("nodes", []))
+
+
 def score(truth, result, failure=None):
     """Score record of one case. result: the discover JSON (None when dynid failed; failure says how)."""
     rec = dict(case=truth["case"], kind=truth["kind"], source=truth["source"], family=truth["family"],
@@ -141,6 +168,12 @@ def score(truth, result, failure=None):
                 rec["within"] = bool(ok and abs(value - ref) <= TOLERANCE * abs(ref))
                 if std is not None and math.isfinite(std):
                     rec["covered"] = bool(ok and abs(value - ref) <= std)
+                    if std > 0:
+                        rec["expected_within"] = math.erf(TOLERANCE * abs(ref) / (math.sqrt(2) * std))
+                if ok and ideal_site(first, eff, ref):
+                    best = eff["ideal"]["best_value"]
+                    rec["ideal"] = best
+                    rec["within_ideal"] = bool(abs(value - best) <= TOLERANCE * abs(best))
             break
     return rec
 

@@ -89,6 +89,26 @@ def main():
     ok &= check("below-floor count reported", s["below_floor"] == 1)
     s_all = run.summarize([right, wrong])
     ok &= check("without flagged cases the rates are unchanged", s_all["named_right"] == s["named_right"])
+
+    # Against what the data allow: a stated 1-sigma of 1e5 on a reference of 1e6 puts a calibrated estimate within
+    # 10 % with probability erf(1 / sqrt 2) = 0.6827; the ideal candidate's best value (1.1e6 here) is compared only
+    # where the finding sits at its site and its reference is the scored one.
+    ok &= check("expected within 10 % at a 10 % 1-sigma is 0.6827", abs(right["expected_within"] - 0.682689) < 1e-6)
+    t = truth(shifts=(2.0,))
+    t["effects"][0]["ideal"] = dict(candidate="grounded_spring", reference=1e6, best_value=1.1e6)
+    at = score.score(t, found(7, value=1.15e6))
+    ok &= check("1.15e6 is within 10 % of the ideal 1.1e6, not of the reference 1e6", at["within_ideal"] and not at["within"])
+    t["effects"][0]["ideal"]["reference"] = 2e6   # the ideal was built for another reference: not comparable
+    ok &= check("an ideal of another reference is not compared", "within_ideal" not in score.score(t, found(7)))
+    t2 = truth(shifts=(2.0,))
+    t2["effects"][0]["accept"]["nodes"] = [7, 8]
+    t2["effects"][0]["ideal"] = dict(candidate="grounded_spring", reference=1e6, best_value=1.1e6)
+    eq = found(8)
+    eq["findings"][0]["location"]["nodes"] = [8, 7]
+    ok &= check("a finding first at an accepted node compares with the ideal", "within_ideal" in score.score(t2, eq))
+    lines = run.parameter_lines([right, at])
+    ok &= check("the table counts both cases, one within 10 % and covered, one within the ideal",
+                "| all | 2 | 1 | 1 | 1.4 |" in lines and any("for the 1 findings at the ideal" in x and ": 1 within" in x for x in lines))
     return 0 if ok else 1
 
 
