@@ -475,13 +475,7 @@ TEST(Discovery, AlignmentWithInertiaForcesTellsProportionalFromLocal) {
   EXPECT_NEAR(stiffness, 1.0, 1e-9);
   EXPECT_NEAR(mass, 1.0, 1e-9);
   Model point = test::UnsupportedCopy(analysis);
-  Element pm;
-  pm.id = 9001;
-  pm.type = ElementType::PointMass;
-  pm.num_nodes = 1;
-  pm.node_ids = {{8, 0}};
-  pm.mass = 40;
-  point.add_element(pm);
+  point.add_element(test::PointMass(9001, 8, 40));
   for (int id : {1, 2, 3}) point.restrain(id, kAllDofs);
   point.finalize();
   const double local_mass = alignment(point);

@@ -434,13 +434,7 @@ TEST(BandRule, CountsModesUntilEnoughAreVisible) {
     const int id = 1000 + i;
     m.add_node(id, Eigen::Vector3d(0.01 * i, -1.0, 0.0));
     const double f = 0.5 + 0.02 * i, mass = 1.0;
-    Element pm;
-    pm.id = 5000 + i;
-    pm.type = ElementType::PointMass;
-    pm.num_nodes = 1;
-    pm.node_ids = {{id, 0}};
-    pm.mass = mass;
-    m.add_element(pm);
+    m.add_element(test::PointMass(5000 + i, id, mass));
     m.add_element(test::GroundedSpring(6000 + i, id, Dof::UY, mass * std::pow(2 * M_PI * f, 2)));
     m.restrain(id, static_cast<DofMask>(kAllDofs & ~dof_bit(Dof::UY)));
   }

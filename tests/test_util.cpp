@@ -51,6 +51,16 @@ Element GroundedSpring(int id, int node, Dof dof, double k) {
   return s;
 }
 
+Element PointMass(int id, int node, double m) {
+  Element p;
+  p.id = id;
+  p.type = ElementType::PointMass;
+  p.num_nodes = 1;
+  p.node_ids = {{node, 0}};
+  p.mass = m;
+  return p;
+}
+
 double SubspaceGap(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
   const Eigen::MatrixXd Qa = Eigen::HouseholderQR<Eigen::MatrixXd>(A).householderQ() *
                              Eigen::MatrixXd::Identity(A.rows(), A.cols());

@@ -124,4 +124,7 @@ Model WithoutSupports(const Model& base);
 /// A one-node spring element to ground on DOF `dof` of node `node`, stiffness k.
 Element GroundedSpring(int id, int node, Dof dof, double k);
 
+/// A point mass element of mass m on node `node` (no rotary inertia).
+Element PointMass(int id, int node, double m);
+
 }  // namespace dynid::test
