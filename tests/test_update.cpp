@@ -1,5 +1,6 @@
 // Model updating with Ceres: the paper's Table 1 beam (f1, f2, combined), ties, fixed parameters, bounds,
 // ill-posed set-ups, and the SMU real shear frames.
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -214,6 +215,53 @@ TEST(Update, RobustLossResistsAnOutlierMode) {
   const double e_plain = (plain.theta - truth).cwiseAbs().maxCoeff(), e_robust = (robust.theta - truth).cwiseAbs().maxCoeff();
   EXPECT_LT(e_robust, 0.05);
   EXPECT_LT(e_robust, 0.5 * e_plain);
+}
+
+// A shape covariance beyond the per-entry noise (FitOptions::shape_covariance_factors): each mode's shape residuals
+// and their derivatives are whitened by (D^2 + F F^T)^(-1/2), D the per-entry std (1 % here). Checked against the
+// dense inverse square root of that covariance (Eigen's SelfAdjointEigenSolver) applied to the plain residuals and
+// Jacobian, to 1e-9 of their largest entry (two routes to one matrix, rounding apart); frequency rows untouched;
+// a mode without factors unchanged; a factor count that does not match the modes is refused, naming both.
+TEST(Update, ShapeCovarianceFactorsWhitenTheShapeResiduals) {
+  Case c = load_case(test::CasesDir() + "/paper-beam-update/combined.yaml");
+  const ModalData m = update_measured_data(c);
+  ParametricModel pm(c.model);
+  for (const Parameter& q : c.update->parameters) pm.add(q);
+  FitOptions o = c.update->options;
+  ASSERT_EQ(o.objective, FitObjective::kCombined);
+  ASSERT_EQ(o.shape_noise_modes.size() + o.shape_noise_entries.size(), 0);  // D = shape_noise I
+  const Linearization plain = linearize(pm, m, pm.nominal(), o);
+  const Eigen::Index a = static_cast<Eigen::Index>(m.dofs.size());
+  std::mt19937 rng(7);
+  std::normal_distribution<double> z(0.0, 1.0);
+  o.shape_covariance_factors.assign(static_cast<std::size_t>(m.num_modes()), Eigen::MatrixXd(a, 0));
+  for (int k = 1; k < m.num_modes(); ++k) {
+    Eigen::MatrixXd F(a, k == 1 ? 1 : 3);
+    for (Eigen::Index i = 0; i < F.size(); ++i) F.data()[i] = 0.02 * z(rng);
+    o.shape_covariance_factors[static_cast<std::size_t>(k)] = F;
+  }
+  const Linearization mixed = linearize(pm, m, pm.nominal(), o);
+  ASSERT_EQ(mixed.r.size(), plain.r.size());
+  const double rtop = plain.r.cwiseAbs().maxCoeff(), jtop = plain.J.cwiseAbs().maxCoeff();
+  for (int k = 0; k < m.num_modes(); ++k) {
+    const Eigen::Index b = plain.block_start[static_cast<std::size_t>(k)];
+    EXPECT_EQ(mixed.r[b], plain.r[b]) << "mode " << k;
+    EXPECT_TRUE(mixed.J.row(b).isApprox(plain.J.row(b))) << "mode " << k;
+    const Eigen::MatrixXd G = o.shape_covariance_factors[static_cast<std::size_t>(k)] / o.shape_noise;
+    const Eigen::MatrixXd C = Eigen::MatrixXd::Identity(a, a) + G * G.transpose();
+    const Eigen::MatrixXd W = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(C).operatorInverseSqrt();
+    EXPECT_LT((mixed.r.segment(b + 1, a) - W * plain.r.segment(b + 1, a)).cwiseAbs().maxCoeff(), 1e-9 * rtop)
+        << "mode " << k;
+    EXPECT_LT((mixed.J.middleRows(b + 1, a) - W * plain.J.middleRows(b + 1, a)).cwiseAbs().maxCoeff(), 1e-9 * jtop)
+        << "mode " << k;
+    if (k > 0) EXPECT_GT((mixed.r.segment(b + 1, a) - plain.r.segment(b + 1, a)).norm(), 1e-3 * rtop) << "mode " << k;
+  }
+  o.shape_covariance_factors.pop_back();
+  const std::string e = test::ErrorOf([&] { linearize(pm, m, pm.nominal(), o); });
+  EXPECT_NE(e.find(std::to_string(m.num_modes() - 1) + " shape covariance factors for " +
+                   std::to_string(m.num_modes()) + " measured modes"),
+            std::string::npos)
+      << e;
 }
 
 // A 2x2-bay, 4-story space frame (720 DOF: the sparse path), 8 stiffness factors (story x half of the plan),

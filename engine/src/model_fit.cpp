@@ -45,6 +45,8 @@ bool FitOptions::IsValid(std::string* why) const {
   for (Eigen::Index k = 0; k < shape_noise_entries.cols(); ++k)
     if ((shape_noise_entries.col(k).array() > 0).count() == 0)
       return fail("per-entry shape noise: every mode needs at least one entry with a std > 0");
+  for (const Eigen::MatrixXd& F : shape_covariance_factors)
+    if (!F.allFinite()) return fail("shape covariance factors must be finite");
   if (!(regularization >= 0)) return fail("regularization must be >= 0");
   if (!(loss_scale > 0)) return fail("loss_scale must be > 0");
   if (max_iterations < 0) return fail("max_iterations must be >= 0");
@@ -95,6 +97,15 @@ class Evaluator {
       throw InputError("fit: per-entry shape noise is " + std::to_string(o.shape_noise_entries.rows()) + " x " +
                        std::to_string(o.shape_noise_entries.cols()) + " for " + std::to_string(meas.dofs.size()) + " DOFs x " +
                        std::to_string(meas.num_modes()) + " measured modes");
+    if (!o.shape_covariance_factors.empty()) {
+      if (o.shape_covariance_factors.size() != static_cast<std::size_t>(meas.num_modes()))
+        throw InputError("fit: " + std::to_string(o.shape_covariance_factors.size()) +
+                         " shape covariance factors for " + std::to_string(meas.num_modes()) + " measured modes");
+      for (const Eigen::MatrixXd& F : o.shape_covariance_factors)
+        if (F.cols() > 0 && F.rows() != static_cast<Eigen::Index>(meas.dofs.size()))
+          throw InputError("fit: a shape covariance factor has " + std::to_string(F.rows()) + " rows for " +
+                           std::to_string(meas.dofs.size()) + " measured DOFs");
+    }
     rows_ = measured_equations(pm.model(), meas.dofs);
     const Model& model = pm.model();
     translations_ = translation_equations(model);
@@ -145,6 +156,22 @@ class Evaluator {
         w_scale_(r, k) = exact ? (sd[r] == 0 ? 1.0 : 0.0) : 1.0 / (sd[r] * sd[r]);
       }
       exact_entries_ += static_cast<int>((sd == 0).count());
+    }
+    // The whitening of each mode's shape residual by (I + G G^T)^(-1/2), G = diag(w_res) F (already whitened by
+    // the per-entry noise): with G = Q S V^T, r -> r - Q diag(1 - 1 / sqrt(1 + s^2)) Q^T r.
+    mix_Q_.assign(static_cast<std::size_t>(p), Eigen::MatrixXd());
+    mix_d_.assign(static_cast<std::size_t>(p), Eigen::VectorXd());
+    for (int k = 0; k < p && !o.shape_covariance_factors.empty(); ++k) {
+      const Eigen::MatrixXd& F = o.shape_covariance_factors[static_cast<std::size_t>(k)];
+      if (F.cols() == 0) continue;
+      const Eigen::MatrixXd G = w_res_.col(k).asDiagonal() * F;
+      const Eigen::JacobiSVD<Eigen::MatrixXd> svd(G, Eigen::ComputeThinU);
+      const Eigen::VectorXd& sv = svd.singularValues();
+      int keep = 0;
+      while (keep < sv.size() && sv[keep] > 1e-6) ++keep;
+      if (keep == 0) continue;
+      mix_Q_[static_cast<std::size_t>(k)] = svd.matrixU().leftCols(keep);
+      mix_d_[static_cast<std::size_t>(k)] = (1.0 - (1.0 + sv.head(keep).array().square()).rsqrt()).matrix();
     }
     m_serep_ = std::min<int>(static_cast<int>(rows_.size()), eo.num_modes);
   }
@@ -372,7 +399,17 @@ class Evaluator {
       ev_.r[k].resize(1 + a);
       ev_.r[k][0] = rf;
       ev_.r[k].tail(a) = w_res_.col(k).cwiseProduct(c * v - U_.col(k));
+      unmix(k, ev_.r[k].tail(a));
     }
+  }
+
+  // Whitens measured mode k's (noise-whitened) shape residuals, or their derivative, by the covariance of its
+  // shape_covariance_factors (identity when it has none).
+  template <class V>
+  void unmix(int k, V&& x) const {
+    const Eigen::MatrixXd& Q = mix_Q_[static_cast<std::size_t>(k)];
+    if (Q.cols() == 0) return;
+    x -= Q * mix_d_[static_cast<std::size_t>(k)].cwiseProduct(Q.transpose() * x);
   }
 
   // The scale c of model shape v that best matches measured mode k (weighted least squares, see w_scale_).
@@ -455,6 +492,7 @@ class Evaluator {
           const Eigen::VectorXd dv = dphi[k].col(q);
           const double dc = wu.dot(dv) / vv - 2.0 * c * wv.dot(dv) / vv;
           out.tail(a) = w_res_.col(k).cwiseProduct(dc * v + c * dv);
+          unmix(k, out.tail(a));
         }
         return out;
       };
@@ -666,6 +704,8 @@ class Evaluator {
   bool complete_ = false;
   Eigen::MatrixXd U_;
   Eigen::MatrixXd w_res_, w_scale_;  // per shape entry and mode: residual weight, weight in the scale c
+  std::vector<Eigen::MatrixXd> mix_Q_;  // per mode: the whitened shape covariance factors' directions ...
+  std::vector<Eigen::VectorXd> mix_d_;  // ... and how much of the residual along each is removed
   int exact_entries_ = 0;            // shape entries with std 0 (no residual)
   Eigen::VectorXd lam_meas_;
   int m_serep_ = 0;

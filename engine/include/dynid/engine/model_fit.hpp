@@ -37,6 +37,12 @@ struct FitOptions {
   /// (the entry the mode was normalised by): the model shape is scaled to match the exact entries, which carry
   /// no residual.
   Eigen::MatrixXd shape_noise_entries;
+  /// Per measured mode, when given (one matrix per mode: measured DOFs x any number of columns, none allowed):
+  /// directions along which the mode's shape is uncertain beyond the noise above, in the same units (relative to
+  /// the mode's largest entry). In `combined` the shape residual's covariance is then diag(std^2) + F F^T and
+  /// the residuals are whitened by its inverse square root: a misfit along F's columns weighs as little as their
+  /// size says. Discovery gives the neighbours of closely spaced modes (docs/method.md, "Closely spaced modes").
+  std::vector<Eigen::MatrixXd> shape_covariance_factors;
   double regularization = 0.0;    ///< Tikhonov weight w: residuals sqrt(w) (theta_p - nominal_p) / scale_p
   enum class Loss { kNone, kHuber, kCauchy };
   Loss loss = Loss::kNone;        ///< robust loss on each mode's frequency residual and, separately, its shape
