@@ -182,6 +182,9 @@ void refit_with_rigid_body_modes(const Problem& p, const ModalData& measured, co
   };
   extend(&fo.frequency_noise_modes, p.noise.frequency);
   extend(&fo.shape_noise_modes, p.noise.shape);
+  if (fo.shape_covariance_factors.size() == static_cast<std::size_t>(used))  // none for the rigid-body modes
+    fo.shape_covariance_factors.resize(static_cast<std::size_t>(d.num_modes()),
+                                       Eigen::MatrixXd(static_cast<Eigen::Index>(d.dofs.size()), 0));
   ParametricModel pm(*p.model);
   std::vector<int> first;
   const Eigen::VectorXd theta0 = install_fitted(f, &pm, &first);

@@ -19,6 +19,58 @@ double median(std::vector<double> v) {
   return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
+// Closely spaced modes (docs/method.md): an identified mode's shape is its model partner's mixed with each other
+// model mode, by about sigma / delta, sigma the mode's relative frequency std from the identification and delta
+// the neighbour's relative distance in frequency (at most 1: a neighbour closer than the frequency's own
+// uncertainty mixes in at the mode's full size). An estimate whose pole is off by sigma mixes the shapes of poles
+// delta apart by that much (first-order perturbation: the coupling over the eigenvalue gap), so a misfit along
+// the neighbour's shape at the sensors (the part orthogonal to the partner's, at the scale the mode is measured
+// at) is no evidence. One factor column per neighbour. Only for frequencies whose std comes from the data: a
+// stated noise is the user's noise model, taken as stated (independent shape entries).
+std::vector<Eigen::MatrixXd> neighbour_mixing(const Model& model, const ModalResult& modes,
+                                              const std::vector<int>& partner, const ModalData& data,
+                                              const NoiseModel& nm) {
+  std::vector<Eigen::MatrixXd> out;
+  const int p = data.num_modes();
+  if (nm.frequency_source != NoiseModel::Source::kData) return out;
+  if (partner.size() != static_cast<std::size_t>(p) || !modes.ok() || p == 0) return out;
+  std::vector<Eigen::Index> ec;
+  for (Eigen::Index j = 0; j < modes.eigenvalues.size(); ++j)
+    if (!modes.rigid_body[j]) ec.push_back(j);
+  const std::vector<int> rows = measured_equations(model, data.dofs);
+  const Eigen::Index a = static_cast<Eigen::Index>(rows.size());
+  auto at_sensors = [&](Eigen::Index col) {
+    Eigen::VectorXd v(a);
+    for (Eigen::Index r = 0; r < a; ++r) v[r] = modes.modes(rows[r], col);
+    return v;
+  };
+  out.assign(static_cast<std::size_t>(p), Eigen::MatrixXd(a, 0));
+  for (int k = 0; k < p; ++k) {
+    const int j = partner[static_cast<std::size_t>(k)];
+    if (j < 0 || j >= static_cast<int>(ec.size())) continue;
+    const Eigen::VectorXd vj = at_sensors(ec[j]);
+    const double vv = vj.squaredNorm();
+    const double top = data.shapes.col(k).cwiseAbs().maxCoeff();
+    if (!(vv > 0) || !(top > 0)) continue;
+    const double c = data.shapes.col(k).dot(vj) / top / vv;  // the model shape's scale at the measured one's
+    const double sigma = nm.frequency_modes.size() == p ? nm.frequency_modes[k] : nm.frequency;
+    const double fj = modes.frequencies_hz[ec[j]];
+    std::vector<Eigen::VectorXd> cols;
+    for (int i = 0; i < static_cast<int>(ec.size()); ++i) {
+      if (i == j) continue;
+      const double delta = std::abs(modes.frequencies_hz[ec[i]] - fj) / fj;
+      const double s = delta > sigma ? sigma / delta : 1.0;
+      if (s < 1e-3) continue;
+      const Eigen::VectorXd vi = at_sensors(ec[i]);
+      cols.push_back(s * c * (vi - (vi.dot(vj) / vv) * vj));
+    }
+    Eigen::MatrixXd& F = out[static_cast<std::size_t>(k)];
+    F.resize(a, static_cast<Eigen::Index>(cols.size()));
+    for (std::size_t q = 0; q < cols.size(); ++q) F.col(static_cast<Eigen::Index>(q)) = cols[q];
+  }
+  return out;
+}
+
 }  // namespace
 
 void add_contamination(const ModalData& data, NoiseModel* nm) {
@@ -186,6 +238,7 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
   p.fit.shape_noise = p.noise.shape;
   if (p.noise.frequency_modes.size()) p.fit.frequency_noise_modes = p.noise.frequency_modes;
   if (p.noise.shape_modes.size()) p.fit.shape_noise_modes = p.noise.shape_modes;
+  p.fit.shape_covariance_factors = neighbour_mixing(model, modes, partner, p.data, p.noise);
   std::vector<int> lone;
   for (const SetAside& s : S->set_aside)
     if (s.reason == SetAside::Reason::kNoPartner) lone.push_back(s.mode);

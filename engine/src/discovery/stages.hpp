@@ -36,6 +36,7 @@ struct Problem {
     FitOptions f = fit;
     f.frequency_noise_modes.resize(0);
     f.shape_noise_modes.resize(0);
+    f.shape_covariance_factors.clear();
     return f;
   }
   CandidateContext context;
