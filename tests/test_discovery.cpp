@@ -358,6 +358,12 @@ TEST(Discovery, TurnedRepeatedPairsAreTheModelsOwnModes) {
   ASSERT_EQ(s.noise.frequency_source, NoiseModel::Source::kData);
   EXPECT_EQ(s.verdict, Verdict::kConsistent) << said(s);
   EXPECT_LT(s.before.mac.minCoeff(), 0.95);  // the turn is seen: a pair's MAC with its partner
+  // Each turned mode's partner has a neighbour within the frequency's uncertainty (share 1), said in a warning.
+  ASSERT_EQ(s.noise.neighbour_mixing.size(), 8);
+  EXPECT_EQ((s.noise.neighbour_mixing.array() == 1.0).count(), 2 * turned);
+  EXPECT_EQ(std::count_if(s.warnings.begin(), s.warnings.end(),
+                          [](const std::string& w) { return w.find("closely spaced modes") != std::string::npos; }),
+            2 * turned);
 }
 
 // One paired mode is a test, not an explanation: the model's own first mode is consistent; a base on a spring

@@ -27,12 +27,13 @@ double median(std::vector<double> v) {
 // the neighbour's shape at the sensors (the part orthogonal to the partner's, at the scale the mode is measured
 // at) is no evidence. One factor column per neighbour. Only for frequencies whose std comes from the data: a
 // stated noise is the user's noise model, taken as stated (independent shape entries).
+// The largest share per mode goes to nm->neighbour_mixing.
 std::vector<Eigen::MatrixXd> neighbour_mixing(const Model& model, const ModalResult& modes,
-                                              const std::vector<int>& partner, const ModalData& data,
-                                              const NoiseModel& nm) {
+                                              const std::vector<int>& partner, const ModalData& data, NoiseModel* nm,
+                                              std::vector<std::string>* warnings) {
   std::vector<Eigen::MatrixXd> out;
   const int p = data.num_modes();
-  if (nm.frequency_source != NoiseModel::Source::kData) return out;
+  if (nm->frequency_source != NoiseModel::Source::kData) return out;
   if (partner.size() != static_cast<std::size_t>(p) || !modes.ok() || p == 0) return out;
   std::vector<Eigen::Index> ec;
   for (Eigen::Index j = 0; j < modes.eigenvalues.size(); ++j)
@@ -45,6 +46,7 @@ std::vector<Eigen::MatrixXd> neighbour_mixing(const Model& model, const ModalRes
     return v;
   };
   out.assign(static_cast<std::size_t>(p), Eigen::MatrixXd(a, 0));
+  nm->neighbour_mixing = Eigen::VectorXd::Zero(p);
   for (int k = 0; k < p; ++k) {
     const int j = partner[static_cast<std::size_t>(k)];
     if (j < 0 || j >= static_cast<int>(ec.size())) continue;
@@ -53,20 +55,29 @@ std::vector<Eigen::MatrixXd> neighbour_mixing(const Model& model, const ModalRes
     const double top = data.shapes.col(k).cwiseAbs().maxCoeff();
     if (!(vv > 0) || !(top > 0)) continue;
     const double c = data.shapes.col(k).dot(vj) / top / vv;  // the model shape's scale at the measured one's
-    const double sigma = nm.frequency_modes.size() == p ? nm.frequency_modes[k] : nm.frequency;
+    const double sigma = nm->frequency_modes.size() == p ? nm->frequency_modes[k] : nm->frequency;
     const double fj = modes.frequencies_hz[ec[j]];
     std::vector<Eigen::VectorXd> cols;
+    double nearest = 0;  // the closest neighbour within the frequency's uncertainty (Hz), if any
     for (int i = 0; i < static_cast<int>(ec.size()); ++i) {
       if (i == j) continue;
       const double delta = std::abs(modes.frequencies_hz[ec[i]] - fj) / fj;
       const double s = delta > sigma ? sigma / delta : 1.0;
       if (s < 1e-3) continue;
+      nm->neighbour_mixing[k] = std::max(nm->neighbour_mixing[k], s);
+      if (s == 1.0 && (nearest == 0 || std::abs(modes.frequencies_hz[ec[i]] - fj) < std::abs(nearest - fj)))
+        nearest = modes.frequencies_hz[ec[i]];
       const Eigen::VectorXd vi = at_sensors(ec[i]);
       cols.push_back(s * c * (vi - (vi.dot(vj) / vv) * vj));
     }
     Eigen::MatrixXd& F = out[static_cast<std::size_t>(k)];
     F.resize(a, static_cast<Eigen::Index>(cols.size()));
     for (std::size_t q = 0; q < cols.size(); ++q) F.col(static_cast<Eigen::Index>(q)) = cols[q];
+    if (nearest > 0 && warnings)
+      warnings->push_back("measured mode at " + fmt_value(data.frequencies_hz[k], 5) + " Hz: the model has modes at " +
+                          fmt_value(fj, 5) + " and " + fmt_value(nearest, 5) +
+                          " Hz, closer than the frequency's uncertainty; the test cannot tell them apart, so its shape "
+                          "is compared with their mixtures (closely spaced modes)");
   }
   return out;
 }
@@ -238,7 +249,8 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
   p.fit.shape_noise = p.noise.shape;
   if (p.noise.frequency_modes.size()) p.fit.frequency_noise_modes = p.noise.frequency_modes;
   if (p.noise.shape_modes.size()) p.fit.shape_noise_modes = p.noise.shape_modes;
-  p.fit.shape_covariance_factors = neighbour_mixing(model, modes, partner, p.data, p.noise);
+  p.fit.shape_covariance_factors = neighbour_mixing(model, modes, partner, p.data, &p.noise, &S->warnings);
+  S->noise.neighbour_mixing = p.noise.neighbour_mixing;
   std::vector<int> lone;
   for (const SetAside& s : S->set_aside)
     if (s.reason == SetAside::Reason::kNoPartner) lone.push_back(s.mode);

@@ -165,6 +165,10 @@ struct NoiseModel {
   /// The model's own discretisation error per measured mode used (relative frequency, discretization_error()),
   /// added in quadrature to the frequency noise: a mesh too coarse to resolve a mode is no missing physics.
   Eigen::VectorXd discretization;
+  /// Closely spaced modes, per measured mode used: the largest share s = min(1, sigma / delta) by which another
+  /// model mode mixes into its shape (docs/method.md); 1 when the model has a mode within the frequency's own
+  /// uncertainty. Empty when the frequency noise is not the identification's.
+  Eigen::VectorXd neighbour_mixing;
 };
 
 /// A measured mode discovery does not use, and why.
