@@ -431,6 +431,7 @@ nlohmann::ordered_json discovery_json(const Case& c, const DiscoveryData& d, con
   j["noise"]["frequency_modes"] = vec(s.noise.frequency_modes);
   j["noise"]["discretization"] = vec(s.noise.discretization);
   j["noise"]["neighbour_mixing"] = vec(s.noise.neighbour_mixing);
+  j["noise"]["unresolved"] = vec(s.noise.unresolved);
   j["set_aside"] = nlohmann::ordered_json::array();
   for (const SetAside& a : s.set_aside)
     j["set_aside"].push_back({{"mode", a.mode + 1}, {"frequency_hz", a.frequency_hz},

@@ -20,14 +20,19 @@ double median(std::vector<double> v) {
 }
 
 // Closely spaced modes (docs/method.md): an identified mode's shape is its model partner's mixed with each other
-// model mode, by about sigma / delta, sigma the mode's relative frequency std from the identification and delta
-// the neighbour's relative distance in frequency (at most 1: a neighbour closer than the frequency's own
-// uncertainty mixes in at the mode's full size). An estimate whose pole is off by sigma mixes the shapes of poles
-// delta apart by that much (first-order perturbation: the coupling over the eigenvalue gap), so a misfit along
-// the neighbour's shape at the sensors (the part orthogonal to the partner's, at the scale the mode is measured
-// at) is no evidence. One factor column per neighbour. Only for frequencies whose std comes from the data: a
-// stated noise is the user's noise model, taken as stated (independent shape entries).
-// The largest share per mode goes to nm->neighbour_mixing.
+// model mode, by about s = r / delta (at most 1), delta the neighbour's relative distance in frequency and r the
+// identification's resolution of the pair. When the neighbour has a measured partner of its own, the
+// identification resolved the two poles and r is the mode's relative frequency std sigma: an estimate whose pole
+// is off by sigma mixes the shapes of poles delta apart by that much (first-order perturbation: the coupling over
+// the eigenvalue gap). When it has none, the sensors see it and the two half-power bands overlap (delta < 2
+// zeta, zeta the identified damping ratio: modal overlap), the test may have merged the two into one estimate: r
+// is then zeta (the half-power half-width; a neighbour delta away responds at the mode's frequency by zeta /
+// delta of its own peak), and the estimate's frequency is pulled toward the neighbour's by s^2 delta (the
+// neighbour's share of the Rayleigh quotient), which joins the mode's frequency std in quadrature
+// (nm->unresolved). A misfit along the neighbour's shape at the
+// sensors (the part orthogonal to the partner's, at the scale the mode is measured at) is no evidence: one factor
+// column per neighbour. Only for frequencies whose std comes from the data: a stated noise is the user's noise
+// model, taken as stated (independent shape entries). The largest share per mode goes to nm->neighbour_mixing.
 std::vector<Eigen::MatrixXd> neighbour_mixing(const Model& model, const ModalResult& modes,
                                               const std::vector<int>& partner, const ModalData& data, NoiseModel* nm,
                                               std::vector<std::string>* warnings) {
@@ -39,14 +44,19 @@ std::vector<Eigen::MatrixXd> neighbour_mixing(const Model& model, const ModalRes
   for (Eigen::Index j = 0; j < modes.eigenvalues.size(); ++j)
     if (!modes.rigid_body[j]) ec.push_back(j);
   const std::vector<int> rows = measured_equations(model, data.dofs);
+  const std::vector<int> translations = translation_equations(model);
   const Eigen::Index a = static_cast<Eigen::Index>(rows.size());
   auto at_sensors = [&](Eigen::Index col) {
     Eigen::VectorXd v(a);
     for (Eigen::Index r = 0; r < a; ++r) v[r] = modes.modes(rows[r], col);
     return v;
   };
+  std::vector<bool> resolved(ec.size(), false);  // model modes with a measured partner of their own
+  for (int j : partner)
+    if (j >= 0 && j < static_cast<int>(ec.size())) resolved[static_cast<std::size_t>(j)] = true;
   out.assign(static_cast<std::size_t>(p), Eigen::MatrixXd(a, 0));
   nm->neighbour_mixing = Eigen::VectorXd::Zero(p);
+  nm->unresolved = Eigen::VectorXd::Zero(p);
   for (int k = 0; k < p; ++k) {
     const int j = partner[static_cast<std::size_t>(k)];
     if (j < 0 || j >= static_cast<int>(ec.size())) continue;
@@ -56,28 +66,42 @@ std::vector<Eigen::MatrixXd> neighbour_mixing(const Model& model, const ModalRes
     if (!(vv > 0) || !(top > 0)) continue;
     const double c = data.shapes.col(k).dot(vj) / top / vv;  // the model shape's scale at the measured one's
     const double sigma = nm->frequency_modes.size() == p ? nm->frequency_modes[k] : nm->frequency;
+    const double zeta = data.damping_ratios.size() == p && std::isfinite(data.damping_ratios[k])
+                            ? std::max(0.0, data.damping_ratios[k])
+                            : 0.0;
     const double fj = modes.frequencies_hz[ec[j]];
     std::vector<Eigen::VectorXd> cols;
-    double nearest = 0;  // the closest neighbour within the frequency's uncertainty (Hz), if any
+    double nearest = 0;  // the closest neighbour within the resolution (Hz), if any
+    double pull2 = 0;    // squared relative frequency pull of unresolved neighbours
     for (int i = 0; i < static_cast<int>(ec.size()); ++i) {
       if (i == j) continue;
       const double delta = std::abs(modes.frequencies_hz[ec[i]] - fj) / fj;
-      const double s = delta > sigma ? sigma / delta : 1.0;
+      const bool merged = !resolved[static_cast<std::size_t>(i)] && zeta > sigma && delta < 2 * zeta &&
+                          sensor_visibility(modes.modes.col(ec[i]), rows, translations) >= kMinPairingVisibility;
+      const double r = merged ? zeta : sigma;
+      const double s = delta > r ? r / delta : 1.0;
       if (s < 1e-3) continue;
       nm->neighbour_mixing[k] = std::max(nm->neighbour_mixing[k], s);
+      if (merged) pull2 += std::pow(s * s * delta, 2);
       if (s == 1.0 && (nearest == 0 || std::abs(modes.frequencies_hz[ec[i]] - fj) < std::abs(nearest - fj)))
         nearest = modes.frequencies_hz[ec[i]];
       const Eigen::VectorXd vi = at_sensors(ec[i]);
       cols.push_back(s * c * (vi - (vi.dot(vj) / vv) * vj));
     }
+    nm->unresolved[k] = std::sqrt(pull2);
     Eigen::MatrixXd& F = out[static_cast<std::size_t>(k)];
     F.resize(a, static_cast<Eigen::Index>(cols.size()));
     for (std::size_t q = 0; q < cols.size(); ++q) F.col(static_cast<Eigen::Index>(q)) = cols[q];
     if (nearest > 0 && warnings)
       warnings->push_back("measured mode at " + fmt_value(data.frequencies_hz[k], 5) + " Hz: the model has modes at " +
                           fmt_value(fj, 5) + " and " + fmt_value(nearest, 5) +
-                          " Hz, closer than the frequency's uncertainty; the test cannot tell them apart, so its shape "
-                          "is compared with their mixtures (closely spaced modes)");
+                          " Hz, closer than the test resolves; it cannot tell them apart, so its shape is compared "
+                          "with their mixtures (closely spaced modes)");
+  }
+  if (nm->unresolved.maxCoeff() > 0) {
+    Eigen::VectorXd f =
+        nm->frequency_modes.size() == p ? nm->frequency_modes : Eigen::VectorXd::Constant(p, nm->frequency);
+    nm->frequency_modes = (f.array().square() + nm->unresolved.array().square()).sqrt();
   }
   return out;
 }
@@ -245,12 +269,12 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
     }
     S->noise = p.noise;
   }
+  p.fit.shape_covariance_factors = neighbour_mixing(model, modes, partner, p.data, &p.noise, &S->warnings);
+  S->noise = p.noise;
   p.fit.frequency_noise = p.noise.frequency;
   p.fit.shape_noise = p.noise.shape;
   if (p.noise.frequency_modes.size()) p.fit.frequency_noise_modes = p.noise.frequency_modes;
   if (p.noise.shape_modes.size()) p.fit.shape_noise_modes = p.noise.shape_modes;
-  p.fit.shape_covariance_factors = neighbour_mixing(model, modes, partner, p.data, &p.noise, &S->warnings);
-  S->noise.neighbour_mixing = p.noise.neighbour_mixing;
   std::vector<int> lone;
   for (const SetAside& s : S->set_aside)
     if (s.reason == SetAside::Reason::kNoPartner) lone.push_back(s.mode);

@@ -165,10 +165,16 @@ struct NoiseModel {
   /// The model's own discretisation error per measured mode used (relative frequency, discretization_error()),
   /// added in quadrature to the frequency noise: a mesh too coarse to resolve a mode is no missing physics.
   Eigen::VectorXd discretization;
-  /// Closely spaced modes, per measured mode used: the largest share s = min(1, sigma / delta) by which another
-  /// model mode mixes into its shape (docs/method.md); 1 when the model has a mode within the frequency's own
-  /// uncertainty. Empty when the frequency noise is not the identification's.
+  /// Closely spaced modes, per measured mode used: the largest share s = min(1, r / delta) by which another
+  /// model mode mixes into its shape (docs/method.md; r the frequency's std, or the damping ratio for a neighbour
+  /// without a measured partner); 1 when the model has a mode within that resolution. Empty when the frequency
+  /// noise is not the identification's.
   Eigen::VectorXd neighbour_mixing;
+  /// Per measured mode used: the relative frequency std added (in quadrature, inside frequency_modes) for model
+  /// modes the sensors see, without a measured partner, that the identification may have merged with it (the
+  /// pull s^2 delta toward each, s = min(1, zeta / delta), zeta the identified damping ratio). Empty like
+  /// neighbour_mixing.
+  Eigen::VectorXd unresolved;
 };
 
 /// A measured mode discovery does not use, and why.
