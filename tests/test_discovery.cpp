@@ -370,7 +370,7 @@ TEST(Discovery, TurnedRepeatedPairsAreTheModelsOwnModes) {
 // identification as one estimate: its frequency between the two, its shape mostly one's, and the other mode left
 // without a measured partner. That is the model's own pair, not missing physics: the estimate's frequency std
 // gains the pull toward the unpartnered neighbour (noise.unresolved) and its shape is compared with their
-// mixtures. Without the damping (a test that resolves far finer than the 1 % spacing) the same 0.3 % offset at a
+// mixtures. At 0.1 % damping (a test that resolves the 0.5 % spacing: delta > 2 zeta) the same 0.3 % offset at a
 // 0.03 % std is evidence, and the model as given is not consistent.
 TEST(Discovery, PairMergedByTheIdentificationIsTheModelsOwn) {
   Frame3DSpec spec = test::SteelFrame3D(1, 1, 2);
@@ -399,7 +399,7 @@ TEST(Discovery, PairMergedByTheIdentificationIsTheModelsOwn) {
   ASSERT_EQ(s.noise.frequency_source, NoiseModel::Source::kData);
   EXPECT_EQ(s.verdict, Verdict::kConsistent) << said(s);
   ASSERT_EQ(s.noise.unresolved.size(), 7);
-  EXPECT_GT(s.noise.unresolved[0], 0.5 * delta);          // the pull s^2 delta, s = min(1, 0.01 / delta) near 1
+  EXPECT_GT(s.noise.unresolved[0], 0.5 * delta);          // the pull s^2 delta, s = min(1, 0.01 / delta) = 1
   EXPECT_EQ(s.noise.unresolved.tail(6).maxCoeff(), 0.0);  // the other modes' neighbours all have partners
   meas.damping_ratios = Eigen::VectorXd::Constant(7, 0.001);
   const DiscoverySummary fine = discover(m, meas, DiscoveryOptions{});

@@ -29,10 +29,10 @@ double median(std::vector<double> v) {
 // is then zeta (the half-power half-width; a neighbour delta away responds at the mode's frequency by zeta /
 // delta of its own peak), and the estimate's frequency is pulled toward the neighbour's by s^2 delta (the
 // neighbour's share of the Rayleigh quotient), which joins the mode's frequency std in quadrature
-// (nm->unresolved). A misfit along the neighbour's shape at the
-// sensors (the part orthogonal to the partner's, at the scale the mode is measured at) is no evidence: one factor
-// column per neighbour. Only for frequencies whose std comes from the data: a stated noise is the user's noise
-// model, taken as stated (independent shape entries). The largest share per mode goes to nm->neighbour_mixing.
+// (nm->unresolved). A misfit along the neighbour's shape at the sensors (the part orthogonal to the partner's, at
+// the scale the mode is measured at) is no evidence: one factor column per neighbour. Only for frequencies whose
+// std comes from the data: a stated noise is the user's noise model, taken as stated (independent shape entries).
+// The largest share per mode goes to nm->neighbour_mixing.
 std::vector<Eigen::MatrixXd> neighbour_mixing(const Model& model, const ModalResult& modes,
                                               const std::vector<int>& partner, const ModalData& data, NoiseModel* nm,
                                               std::vector<std::string>* warnings) {
