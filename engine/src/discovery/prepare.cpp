@@ -19,6 +19,15 @@ double median(std::vector<double> v) {
   return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
+// A further relative std per mode joins the frequency noise in quadrature (the one level per mode when the noise
+// model has none per mode yet).
+void add_frequency_std(NoiseModel* nm, const Eigen::VectorXd& extra) {
+  const Eigen::Index p = extra.size();
+  const Eigen::VectorXd f =
+      nm->frequency_modes.size() == p ? nm->frequency_modes : Eigen::VectorXd::Constant(p, nm->frequency);
+  nm->frequency_modes = (f.array().square() + extra.array().square()).sqrt();
+}
+
 // Closely spaced modes (docs/method.md): an identified mode's shape is its model partner's mixed with each other
 // model mode, by about s = r / delta (at most 1), delta the neighbour's relative distance in frequency and r the
 // identification's resolution of the pair. When the neighbour has a measured partner of its own, the
@@ -98,11 +107,7 @@ std::vector<Eigen::MatrixXd> neighbour_mixing(const Model& model, const ModalRes
                           " Hz, closer than the test resolves; it cannot tell them apart, so its shape is compared "
                           "with their mixtures (closely spaced modes)");
   }
-  if (nm->unresolved.maxCoeff() > 0) {
-    Eigen::VectorXd f =
-        nm->frequency_modes.size() == p ? nm->frequency_modes : Eigen::VectorXd::Constant(p, nm->frequency);
-    nm->frequency_modes = (f.array().square() + nm->unresolved.array().square()).sqrt();
-  }
+  if (nm->unresolved.maxCoeff() > 0) add_frequency_std(nm, nm->unresolved);
   return out;
 }
 
@@ -254,7 +259,6 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
   p.data_modes = keep;
   p.modes = p.data.num_modes();
   p.noise = noise_model(p.data, o, &S->warnings);
-  S->noise = p.noise;
   // The model's lowest modes, solved once: for its discretisation error and for the candidates' units.
   const int count = partner.empty() ? measured.num_modes() : *std::max_element(partner.begin(), partner.end()) + 1;
   const ModalResult modes = lowest_modes(model, count);
@@ -263,14 +267,10 @@ void prepare(const Model& model, const ModalData& measured, const DiscoveryOptio
     const Eigen::VectorXd disc = discretization_error(model, modes, count);
     p.noise.discretization.resize(p.modes);
     for (int k = 0; k < p.modes; ++k) p.noise.discretization[k] = partner[static_cast<std::size_t>(k)] < disc.size() ? disc[partner[static_cast<std::size_t>(k)]] : 0.0;
-    if (p.noise.discretization.maxCoeff() > 0) {
-      Eigen::VectorXd f = p.noise.frequency_modes.size() ? p.noise.frequency_modes : Eigen::VectorXd::Constant(p.modes, p.noise.frequency);
-      p.noise.frequency_modes = (f.array().square() + p.noise.discretization.array().square()).sqrt();
-    }
-    S->noise = p.noise;
+    if (p.noise.discretization.maxCoeff() > 0) add_frequency_std(&p.noise, p.noise.discretization);
   }
   p.fit.shape_covariance_factors = neighbour_mixing(model, modes, partner, p.data, &p.noise, &S->warnings);
-  S->noise = p.noise;
+  S->noise = p.noise;  // the noise model as the fit uses it
   p.fit.frequency_noise = p.noise.frequency;
   p.fit.shape_noise = p.noise.shape;
   if (p.noise.frequency_modes.size()) p.fit.frequency_noise_modes = p.noise.frequency_modes;
