@@ -46,10 +46,12 @@ import uff                   # noqa: E402
 # identified modes' neighbours weighed in the shapes' noise (closely spaced modes), each run once on cases never seen.
 # "test11" (4096096) was committed in session 73 (2026-12-07) before it was drawn: the head and the head with pairs
 # the identification may have merged (unpartnered neighbours within the half-power band), each run once.
+# "test12" (8192192) was committed in session 74 (2026-12-08) before it was drawn: the head and the head with a
+# finding's equivalent sites completed beyond the shortlist, each run once on cases never seen.
 MASTER_SEED = {"dev": 1001, "ci": 2002, "test": 4004, "test2": 8008, "test3": 16016, "test4": 32032,
                "test5": 64064, "test6": 128128, "test7": 256256,
                "test8": 512512, "test9": 1024024, "test10": 2048048,
-               "test11": 4096096}
+               "test11": 4096096, "test12": 8192192}
 # Cases per truth kind in a split (half of each from modal data, half from recordings).
 KIND_COUNTS = {"attached_mass": 30, "sensor_mass": 30, "distributed_mass": 30, "joint_flexibility": 30,
                "support_flexibility": 30, "support_spring": 30, "damage": 30, "shear": 30, "preload": 30,
