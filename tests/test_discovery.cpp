@@ -1305,5 +1305,75 @@ TEST(DiscoveryExpect, DamageOverMoreElementsIsComparedByItsFlexibility) {
   EXPECT_NEAR(c.parameter_error, 0.05, 1e-9);
 }
 
+// A spring in ux at any node of a floor the data see as one rigid body predicts the same data, and the finding
+// names every such site it tried. The screen ranks them by a linearisation at the model as given, and the
+// shortlist's cut (screen_fit 2 here) falls inside the set: the sites beyond it whose screened columns are as
+// parallel to the finding's as its fitted equivalents' are fitted too (discovery.cpp, complete_equivalents). The
+// roof of a 3-bay portal (13 nodes) with a ground spring in ux at one of them, 0.5 % / 5 % noise: the finding's
+// site holds roof nodes the shortlist did not take, and only sites that full fits find equivalent (each roof
+// spring fitted alone, the equivalence test of name_equivalent_sites).
+TEST(DiscoveryStages, EquivalentSitesBeyondTheShortlistAreTried) {
+  Frame2DSpec spec = portal();
+  spec.bays = 3;
+  spec.divisions = 4;
+  const Model analysis = make_frame2d(spec);
+  double top = -1e300;
+  for (const Node& n : analysis.nodes()) top = std::max(top, n.x.y());
+  std::vector<int> roof;
+  for (const Node& n : analysis.nodes())
+    if (std::abs(n.x.y() - top) < 1e-9) roof.push_back(n.id);
+  ASSERT_EQ(roof.size(), 13u);
+  Model truth = test::UnsupportedCopy(analysis);
+  truth.add_element(test::GroundedSpring(9001, roof[7], Dof::UX, 1e6));
+  for (const Node& n : analysis.nodes())
+    if (std::abs(n.x.y()) < 1e-9) truth.restrain(n.id, kAllDofs);
+  truth.finalize();
+  const ModalData meas = exact_modes(truth, analysis, 6);
+  DiscoveryOptions o;
+  o.screen_fit = 2;
+  o.frequency_noise = 0.005;
+  o.shape_noise = 0.05;
+  internal::Problem p;
+  DiscoverySummary S;
+  internal::prepare(analysis, meas, o, {}, &p, &S);
+  const Localization L = internal::locate(p);
+  const internal::Screening sc = internal::screen(p);
+  const std::vector<int> list = internal::shortlist(p, sc, L);
+  p.n = p.modes * (1 + static_cast<int>(p.data.dofs.size()));
+  p.chi2_0 = sc.chi2;
+  p.chi2_0_frequency = sc.chi2_frequency;
+  const auto roof_ux = [&](const Candidate& c) {
+    return c.kind() == "grounded_spring" && c.description().find(" ux ") != std::string::npos &&
+           std::find(roof.begin(), roof.end(), c.site().nodes.at(0)) != roof.end();
+  };
+  std::set<int> shortlisted;
+  for (int k : list)
+    if (roof_ux(*p.library[k])) shortlisted.insert(p.library[k]->site().nodes[0]);
+  std::vector<internal::SetFit> fits;
+  for (const auto& c : p.library)
+    if (roof_ux(*c)) fits.push_back(internal::fit_set(p, {c.get()}));
+
+  const DiscoverySummary d = discover(analysis, meas, o);
+  ASSERT_EQ(d.verdict, Verdict::kMissingPhysics) << said(d);
+  ASSERT_EQ(d.findings.at(0).kind, "grounded_spring") << said(d);
+  const internal::SetFit* own = nullptr;
+  for (const internal::SetFit& f : fits)
+    if (f.set[0]->description() == d.findings[0].description) own = &f;
+  ASSERT_NE(own, nullptr) << said(d);
+  const double le = internal::log_evidence(p, *own);
+  const internal::ErrorScale es = internal::error_scale(p, *own);
+  std::set<int> equivalent;
+  for (const internal::SetFit& f : fits)
+    if (internal::log_evidence(p, f) >= le - o.ambiguity &&
+        internal::scaled_norm2(p, f.residuals - own->residuals, es) <= 2 * o.ambiguity)
+      equivalent.insert(f.set[0]->site().nodes[0]);
+  int beyond = 0;
+  for (int n : d.findings[0].site.nodes) {
+    EXPECT_TRUE(equivalent.count(n)) << "node " << n << " is not equivalent: " << said(d);
+    beyond += !shortlisted.count(n);
+  }
+  EXPECT_GT(beyond, 0) << "only shortlisted sites named: " << said(d);
+}
+
 }  // namespace
 }  // namespace dynid

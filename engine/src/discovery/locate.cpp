@@ -73,7 +73,7 @@ Screening screen(const Problem& p) {
   std::vector<const Candidate*> all;
   for (const auto& c : p.library) all.push_back(c.get());
   const std::vector<int> first = install_candidates(&pm, all);
-  const Linearization lin = linearize(pm, p.data, pm.nominal(), p.fit);
+  Linearization lin = linearize(pm, p.data, pm.nominal(), p.fit);
   Screening s;
   s.model_hz = lin.model_hz;
   s.mac = lin.mac;
@@ -82,6 +82,7 @@ Screening screen(const Problem& p) {
   s.chi2 = lin.r.squaredNorm();
   for (int b : lin.block_start) s.chi2_frequency += lin.r[b] * lin.r[b];
   s.drop.assign(all.size(), 0.0);
+  s.column.assign(first.begin(), first.end());
   for (std::size_t k = 0; k < all.size(); ++k) {
     // The magnitude (first) parameter's column: the linearised chi-square drop g^2 / h of a step along it,
     // zero when the step would leave the bounds at once.
@@ -94,6 +95,7 @@ Screening screen(const Problem& p) {
     if ((q.nominal <= q.lower && step < 0) || (q.nominal >= q.upper && step > 0)) continue;
     s.drop[k] = g * g / h;
   }
+  s.J = std::move(lin.J);
   return s;
 }
 

@@ -95,6 +95,10 @@ Localization locate(const Problem& p);
 /// The linearised chi-square drop of every candidate (0 for those not screened: global ones), one eigen-solve.
 struct Screening {
   std::vector<double> drop;        ///< per library candidate
+  /// The linearisation's Jacobian of the whitened residuals at the model as given (all candidates' parameters),
+  /// and each candidate's magnitude column in it.
+  Eigen::MatrixXd J;
+  std::vector<Eigen::Index> column;
   Eigen::VectorXd model_hz, mac;   ///< the model as given, per measured mode
   std::vector<char> paired;        ///< per measured mode: a plausible partner in the model as given
   double chi2 = 0, chi2_frequency = 0;
