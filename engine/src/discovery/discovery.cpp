@@ -277,6 +277,12 @@ std::vector<std::size_t> report_findings(const Problem& p, const Selection& sel,
 
 using Equivalents = std::map<const Candidate*, std::vector<const Candidate*>>;
 
+// The successful single fit of candidate c among `singles`, or null.
+const SetFit* single_fit_of(const std::vector<SetFit>& singles, const Candidate* c) {
+  const auto it = std::find_if(singles.begin(), singles.end(), [&](const SetFit& f) { return f.ok && f.set[0] == c; });
+  return it == singles.end() ? nullptr : &*it;
+}
+
 // Whether the single fit g predicts the data as `own` does (its site is equivalent): of own's kind, about the same
 // evidence, whitened predictions within 2 x ambiguity in chi-square at own's error levels.
 bool equivalent_fit(const Problem& p, const SetFit& own, const SetFit& g) {
@@ -295,9 +301,8 @@ Equivalents name_equivalent_sites(const Problem& p, const Selection& sel, const 
   Equivalents equivalent;
   for (std::size_t k = 0; k < order.size(); ++k) {
     const Candidate* c = sel.fit.set[order[k]];
-    const auto own =
-        std::find_if(singles.begin(), singles.end(), [&](const SetFit& f) { return f.ok && f.set[0] == c; });
-    if (own == singles.end()) continue;
+    const SetFit* own = single_fit_of(singles, c);
+    if (!own) continue;
     for (const SetFit& g : singles) {
       if (!equivalent_fit(p, *own, g)) continue;
       equivalent[c].push_back(g.set[0]);
@@ -340,9 +345,8 @@ void complete_equivalents(const Problem& p, const Screening& sc, const Selection
   for (const Candidate* c : sel.fit.set) {
     if (c->global()) continue;
     const int ci = index.at(c);
-    const auto own =
-        std::find_if(singles->begin(), singles->end(), [&](const SetFit& f) { return f.ok && f.set[0] == c; });
-    if (own == singles->end()) continue;
+    const SetFit* own = single_fit_of(*singles, c);
+    if (!own) continue;
     double least = 2;
     for (const SetFit& g : *singles)
       if (equivalent_fit(p, *own, g)) least = std::min(least, cosine(ci, index.at(g.set[0])));
@@ -354,8 +358,10 @@ void complete_equivalents(const Problem& p, const Screening& sc, const Selection
       if (cs >= least) near.push_back({cs, d});
     }
     std::stable_sort(near.begin(), near.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-    for (std::size_t t = 0; t < near.size() && t < static_cast<std::size_t>(p.options.screen_fit); ++t)
-      if (!fitted[near[t].second]) fitted[near[t].second] = 1, more.push_back(near[t].second);
+    for (std::size_t t = 0; t < near.size() && t < static_cast<std::size_t>(p.options.screen_fit); ++t) {
+      fitted[near[t].second] = 1;
+      more.push_back(near[t].second);
+    }
   }
   if (more.empty()) return;
   std::vector<SetFit> fits(more.size());
